@@ -8,8 +8,10 @@ packages=(
   libmujoco-dev libmujoco-samples libqhull-dev      # physics (+ viewer, testxml)
   libtorch-dev libopenblas0-pthread                 # neural networks on OpenBLAS
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
+  nlohmann-json3-dev                                # JSON of evaluation summaries (report)
   libgtest-dev libgmock-dev libbenchmark-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri libgl-dev # headless rendering
+  libopengl-dev                                     # libOpenGL.so: GL without GLX, for EGL (report)
   ffmpeg gnuplot-nox                                # video, plots
 )
 

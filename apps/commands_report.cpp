@@ -1,0 +1,90 @@
+// `comorph report ...` and `comorph render-mjcf ...`: Markdown/HTML reports of
+// run directories, and headless videos of any MJCF.
+#include <mujoco/mujoco.h>
+
+#include <iostream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "command_registry.hpp"
+#include "report/render_episode.hpp"
+#include "report/report.hpp"
+
+namespace {
+
+// `--out x.mp4` -> x-strip.png beside it.
+std::string strip_path_for(const std::string& video) {
+  const auto dot = video.rfind('.');
+  const auto slash = video.rfind('/');
+  const bool has_ext = dot != std::string::npos && (slash == std::string::npos || dot > slash);
+  return (has_ext ? video.substr(0, dot) : video) + "-strip.png";
+}
+
+comorph::cli::CommandRegistration registration{[](CLI::App& app) {
+  // --- report ---
+  auto* report = app.add_subcommand(
+      "report", "write report.md and report.html: the paper's tables beside ours, training curves, configurations");
+  static std::vector<std::string> runs;
+  static comorph::report::ReportOptions options;
+  report->add_option("runs", runs, "run directories (run.yaml, episodes.csv, eval-*.json; docs/report.md)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  report->add_option("--out,-o", options.out_dir, "output directory (created)")->required();
+  report->add_option("--reference", options.reference_path, "paper tables YAML (default: configs/reference/paper-tables.yaml)");
+  report->add_option("--window", options.curve_window, "episodes in the training curves' moving averages")
+      ->capture_default_str();
+  report->callback([] {
+    const auto result = comorph::report::write_report(runs, options);
+    std::cout << "wrote " << result.markdown_path << ", " << result.html_path << " and " << result.images.size()
+              << " image(s)\n";
+  });
+
+  // --- render-mjcf ---
+  auto* render = app.add_subcommand(
+      "render-mjcf", "step any MJCF passively and render it headless (EGL) to an .mp4 and a keyframe strip .png");
+  static std::string mjcf, out;
+  static int frames = 120;
+  static int steps_per_frame = 0;
+  static comorph::report::RenderOptions ropt;
+  render->add_option("--mjcf", mjcf, "MJCF file")->required()->check(CLI::ExistingFile);
+  render->add_option("--out,-o", out, "video file (.mp4); the strip goes to <out>-strip.png")->required();
+  render->add_option("--frames", frames, "frames to render")->capture_default_str();
+  render->add_option("--width", ropt.width, "frame width, pixels")->capture_default_str();
+  render->add_option("--height", ropt.height, "frame height, pixels")->capture_default_str();
+  render->add_option("--fps", ropt.video.fps, "video frames a second")->capture_default_str();
+  render->add_option("--steps-per-frame", steps_per_frame,
+                     "physics steps between frames (default: as many as make 1/fps seconds)");
+  render->add_option("--track", ropt.camera.track_body, "body the camera follows (default: free camera)");
+  render->add_option("--distance", ropt.camera.distance_m, "camera distance, metres")->capture_default_str();
+  render->add_option("--codec", ropt.video.codec, "ffmpeg video encoder (libx264, mpeg4)")->capture_default_str();
+  render->callback([] {
+    char error[1000] = "";
+    std::unique_ptr<mjModel, void (*)(mjModel*)> model(mj_loadXML(mjcf.c_str(), nullptr, error, sizeof(error)),
+                                                         mj_deleteModel);
+    if (!model) throw std::runtime_error(fmt::format("{}: {}", mjcf, error));
+    std::unique_ptr<mjData, void (*)(mjData*)> data(mj_makeData(model.get()), mj_deleteData);
+    const int steps = steps_per_frame > 0
+                          ? steps_per_frame
+                          : std::max(1, static_cast<int>(1.0 / (ropt.video.fps * model->opt.timestep) + 0.5));
+    ropt.video_path = out;
+    ropt.strip_path = strip_path_for(out);
+    ropt.max_frames = frames;
+    const auto result = comorph::report::render_episode(
+        model.get(), data.get(),
+        [&] {
+          for (int i = 0; i < steps; ++i) mj_step(model.get(), data.get());
+          return true;
+        },
+        ropt);
+    std::cout << fmt::format("wrote {} ({} frames of {} x {} px, {} physics steps a frame, {:.2f} s simulated) and {} "
+                             "(renderer: {})\n",
+                             out, result.frames, ropt.width, ropt.height, steps, data->time, ropt.strip_path,
+                             result.gl_renderer);
+  });
+}};
+
+}  // namespace

@@ -1,0 +1,152 @@
+#include "report/metrics.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+namespace comorph::report {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+nlohmann::json number_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+
+double read_number_or_null(const nlohmann::json& j, const std::string& key, const std::string& where) {
+  if (j.is_null()) return kNaN;
+  if (!j.is_number()) throw std::runtime_error(fmt::format("{}: key '{}' is not a number or null", where, key));
+  return j.get<double>();
+}
+
+const nlohmann::json& need(const nlohmann::json& j, const std::string& key, const std::string& where) {
+  auto it = j.find(key);
+  if (it == j.end()) throw std::runtime_error(fmt::format("{}: missing key '{}'", where, key));
+  return *it;
+}
+
+}  // namespace
+
+FWeights FWeights::paper_fit() {
+  FWeights w;
+  w.t_max_s = 120.0;
+  w.energy_per_module = false;
+  return w;
+}
+
+double objective_F(const EpisodeRecord& e, const FWeights& w) {
+  if (w.t_max_s <= 0 || w.battery_capacity_J <= 0)
+    throw std::invalid_argument("FWeights: t_max_s and battery_capacity_J must be > 0");
+  if (w.energy_per_module && e.modules_total < 1)
+    throw std::invalid_argument(fmt::format("episode {}: modules_total {} must be >= 1 to normalise energy",
+                                            e.episode, e.modules_total));
+  const double T = e.time_s / w.t_max_s;
+  const double capacity = w.battery_capacity_J * (w.energy_per_module ? e.modules_total : 1);
+  const double E = e.energy_J / capacity;
+  const double D = e.distance_fraction;
+  return -w.w_t * T - w.w_e * E + w.w_d * D;
+}
+
+const std::vector<std::string>& paper_stair_keys() {
+  static const std::vector<std::string> keys = {"0.04", "0.06", "0.08"};
+  return keys;
+}
+
+std::string stair_key(double stair_height_m) { return fmt::format("{:.2f}", stair_height_m); }
+
+Metrics summarize(const std::vector<EpisodeRecord>& records, const FWeights& weights) {
+  Metrics m;
+  m.episodes = static_cast<int>(records.size());
+  std::map<std::string, std::pair<int, int>> per_height;  // key -> (successes, episodes)
+  for (const auto& k : paper_stair_keys()) per_height[k] = {0, 0};
+  double time_sum = 0, energy_sum = 0, F_sum = 0;
+  int successes = 0;
+  for (const auto& r : records) {
+    const std::string key = stair_key(r.stair_height_m);
+    auto& [wins, count] = per_height[key];
+    ++count;
+    if (r.success) {
+      ++wins;
+      ++successes;
+      time_sum += r.time_s;
+      energy_sum += r.energy_J;
+    }
+    F_sum += objective_F(r, weights);
+    ++m.configurations[key][configuration_sequence(r.configurations)];
+    ++m.terminations[r.termination];
+  }
+  double rate_sum = 0;
+  int heights = 0;
+  for (const auto& [key, wc] : per_height) {
+    const auto [wins, count] = wc;
+    m.success_rate[key] = count > 0 ? static_cast<double>(wins) / count : kNaN;
+    if (count > 0) {
+      rate_sum += m.success_rate[key];
+      ++heights;
+    }
+  }
+  m.success_rate["avg"] = heights > 0 ? rate_sum / heights : kNaN;
+  m.time_s = successes > 0 ? time_sum / successes : kNaN;
+  m.energy_J = successes > 0 ? energy_sum / successes : kNaN;
+  m.F = m.episodes > 0 ? F_sum / m.episodes : kNaN;
+  return m;
+}
+
+nlohmann::json to_json(const Metrics& m) {
+  nlohmann::json j;
+  j["success_rate"] = nlohmann::json::object();
+  for (const auto& [k, v] : m.success_rate) j["success_rate"][k] = number_or_null(v);
+  j["time_s"] = number_or_null(m.time_s);
+  j["energy_J"] = number_or_null(m.energy_J);
+  j["F"] = number_or_null(m.F);
+  j["configurations"] = nlohmann::json::object();
+  for (const auto& [height, counts] : m.configurations) j["configurations"][height] = counts;
+  j["terminations"] = m.terminations;
+  j["episodes"] = m.episodes;
+  return j;
+}
+
+Metrics metrics_from_json(const nlohmann::json& j, const std::string& where) {
+  if (!j.is_object()) throw std::runtime_error(fmt::format("{}: not a JSON object", where));
+  Metrics m;
+  const auto& rates = need(j, "success_rate", where);
+  if (!rates.is_object()) throw std::runtime_error(fmt::format("{}: key 'success_rate' is not an object", where));
+  for (const auto& k : paper_stair_keys()) need(rates, k, where + " success_rate");
+  need(rates, "avg", where + " success_rate");
+  for (auto it = rates.begin(); it != rates.end(); ++it)
+    m.success_rate[it.key()] = read_number_or_null(it.value(), "success_rate." + it.key(), where);
+  m.time_s = read_number_or_null(need(j, "time_s", where), "time_s", where);
+  m.energy_J = read_number_or_null(need(j, "energy_J", where), "energy_J", where);
+  m.F = read_number_or_null(need(j, "F", where), "F", where);
+  try {
+    m.configurations = need(j, "configurations", where).get<std::map<std::string, std::map<std::string, int>>>();
+    m.terminations = need(j, "terminations", where).get<std::map<std::string, int>>();
+    m.episodes = need(j, "episodes", where).get<int>();
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(fmt::format("{}: configurations, terminations or episodes malformed: {}", where, e.what()));
+  }
+  return m;
+}
+
+void write_metrics_json(const std::string& path, const Metrics& metrics) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(fmt::format("cannot write {}", path));
+  out << to_json(metrics).dump(2) << "\n";
+  if (!out) throw std::runtime_error(fmt::format("error writing {}", path));
+}
+
+Metrics read_metrics_json(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("cannot open {}", path));
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw std::runtime_error(fmt::format("{}: invalid JSON: {}", path, e.what()));
+  }
+  return metrics_from_json(j, path);
+}
+
+}  // namespace comorph::report

@@ -1,0 +1,49 @@
+// A run directory as the trainer/evaluator leaves it (layout: docs/report.md):
+//   run.yaml             what the run is (RunInfo below)
+//   episodes.csv         one row per training episode (episode_record.hpp)
+//   eval-<scenario>.json one evaluation summary per test scenario (metrics.hpp)
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "report/metrics.hpp"
+
+namespace comorph::report {
+
+// run.yaml. Example:
+//   name: hier-td3        # optional; default: the directory's name
+//   kind: hierarchical    # hierarchical | fixed
+//   modules: 10           # fixed: the chain's modules; hierarchical: most modules it may choose (C_n)
+//   algo: td3             # td3 | sac (motion learner)
+//   scenario: default     # training scenario: default | obstacles7 | obstacles8 | mixed
+//   episodes: 4300        # optional: training episodes run (warm-up included)
+//   preset: quick         # optional: config preset used
+//   notes: "..."          # optional free text shown in the report
+struct RunInfo {
+  std::string name;
+  std::string kind;
+  int modules = 0;
+  std::string algo;
+  std::string scenario = "default";
+  int episodes = 0;  // 0 = not given
+  std::string preset;
+  std::string notes;
+};
+
+struct RunDir {
+  std::string path;
+  RunInfo info;
+  std::map<std::string, Metrics> evals;  // test scenario -> its eval-<scenario>.json
+  std::string episodes_csv;              // path of episodes.csv
+};
+
+RunInfo read_run_info(const std::string& run_yaml_path, const std::string& default_name);
+void write_run_info(const std::string& run_yaml_path, const RunInfo& info);
+
+// Checks and reads a run directory: throws naming every missing file
+// (run.yaml, episodes.csv, at least one eval-*.json) or the malformed one.
+RunDir load_run_dir(const std::string& path);
+
+}  // namespace comorph::report
