@@ -1,0 +1,178 @@
+// `comorph export-mjcf`, `comorph physics-table`, `comorph demo`: the simulated
+// robot and its scenario (src/sim, src/control, src/task).
+#include <fmt/format.h>
+
+#include <cmath>
+#include <iostream>
+#include <stdexcept>
+
+#include "command_registry.hpp"
+#include "sim/mjcf.hpp"
+#include "sim/model.hpp"
+#include "task/env_config.hpp"
+#include "task/multitask_env.hpp"
+#include "task/physics_table.hpp"
+#include "task/scripted_pilot.hpp"
+
+namespace {
+
+using namespace comorph;
+
+struct SimOptions {
+  std::string config_dir = "configs/sim";
+  int modules = 4;
+  double stair_height = 0;
+  int obstacles = -1;
+  std::uint64_t seed = 1;
+  std::string variant = "standard";
+  bool json = false;
+  int seeds = 3;
+  bool quick = false;
+};
+
+task::EnvConfig load_config(const std::string& dir) { return task::load_env_config(dir); }
+
+std::string num(double v, int digits) {
+  return std::isnan(v) ? std::string("-") : fmt::format("{:.{}f}", v, digits);
+}
+std::string json_num(double v, int digits) {
+  return std::isnan(v) ? std::string("null") : fmt::format("{:.{}f}", v, digits);
+}
+
+void run_export(const SimOptions& o) {
+  const task::EnvConfig c = load_config(o.config_dir);
+  const sim::SceneLayout layout = sim::generate_scene(c.scene, o.seed, o.stair_height, o.obstacles,
+                                                      sim::parse_variant(o.variant));
+  const std::string xml = sim::build_mjcf(o.modules, c.robot, c.scene, layout);
+  sim::compile_mjcf(xml);  // never hand out a file MuJoCo would reject
+  std::cout << xml;
+}
+
+void run_physics_table(const SimOptions& o) {
+  const task::EnvConfig c = load_config(o.config_dir);
+  task::PhysicsTableOptions opt;
+  opt.seeds = o.seeds;
+  if (o.quick) opt.modules = {2, 6};
+  std::cerr << "physics-table: stair-gait search (" << opt.amplitudes.size() * opt.phases.size()
+            << " candidates max) + " << opt.seeds << " seeds per row\n";
+  const auto rows = task::physics_table(c, opt, [](int i, int total, const task::PhysicsRow& r) {
+    std::cerr << fmt::format("  [{}/{}] {} modules, {:.2f} m: climbed {:.2f}\n", i, total, r.modules,
+                             r.stair_height_m, r.climbed);
+  });
+  if (o.json) {
+    std::cout << "[\n";
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const auto& r = rows[i];
+      std::cout << fmt::format(
+          "  {{\"modules\": {}, \"stair_height_m\": {:.3f}, \"climbed\": {:.3f}, \"time_s\": {}, "
+          "\"energy_J\": {}, \"watts_per_module\": {}, \"turn_deg_s\": {:.1f}, "
+          "\"gait\": {{\"a0\": {:.2f}, \"a2\": {:.2f}, \"a3\": {:.2f}, \"a4\": {:.2f}}}}}{}\n",
+          r.modules, r.stair_height_m, r.climbed, json_num(r.time_s, 2), json_num(r.energy_J, 1),
+          json_num(r.watts_per_module, 2), r.turn_deg_s, r.gait.speed, r.gait.amp_front, r.gait.phase,
+          r.gait.amp_back, i + 1 < rows.size() ? "," : "");
+    }
+    std::cout << "]\n";
+    return;
+  }
+  std::cout << fmt::format("{:>7} {:>14} {:>8} {:>8} {:>10} {:>16} {:>12}  {}\n", "modules", "stair_height_m",
+                           "climbed", "time_s", "energy_J", "watts_per_module", "turn_deg_s",
+                           "gait (a2=a4, a3)");
+  for (const auto& r : rows)
+    std::cout << fmt::format("{:>7} {:>14.2f} {:>8.2f} {:>8} {:>10} {:>16} {:>12.1f}  ({:+.2f}, {:+.2f})\n",
+                             r.modules, r.stair_height_m, r.climbed, num(r.time_s, 2), num(r.energy_J, 1),
+                             num(r.watts_per_module, 2), r.turn_deg_s, r.gait.amp_front, r.gait.phase);
+}
+
+void run_demo(const SimOptions& o) {
+  const task::EnvConfig c = load_config(o.config_dir);
+  task::MultiTaskEnv env(c);
+  task::EpisodeSpec spec;
+  spec.seed = o.seed;
+  spec.modules = o.modules;
+  spec.stair_height = o.stair_height;
+  spec.obstacles = o.obstacles;
+  spec.variant = sim::parse_variant(o.variant);
+  env.reset(spec);
+  const sim::SceneLayout& s = env.world().layout();
+  std::cout << fmt::format(
+      "demo: {} modules, seed {}, stairs 3 x {:.2f} m, {} obstacles ({}), target at ({:.2f}, {:.2f}) m, "
+      "start distance {:.2f} m\n",
+      o.modules, o.seed, s.stair_height, s.obstacles.size(), sim::variant_name(s.variant), s.target_x,
+      s.target_y, env.metrics().initial_distance_m);
+  task::ScriptedPilot pilot;
+  // The stair gait of the physics-table search that climbs all three heights for 4+ modules.
+  pilot.params().gait = {1.0f, 1.0f, -0.2f, 1.0f};
+  pilot.plan(env);
+  float action[control::kActionSize];
+  control::MotionMode mode = env.mode(), last_mode = env.mode();
+  int last_label = env.scene_label();
+  double reward_sum = 0;
+  std::cout << fmt::format("  t={:6.2f} s  event: start in {} mode, scene label {}\n", 0.0,
+                           control::mode_name(mode), last_label);
+  while (!env.done()) {
+    pilot.act(env, action, mode);
+    const task::StepResult& r = env.step(action, mode);
+    reward_sum += r.reward;
+    const double t = env.metrics().time_s;
+    const double* head = env.world().module_pos(0);
+    if (mode != last_mode)
+      std::cout << fmt::format("  t={:6.2f} s  event: mode {} -> {}\n", t, control::mode_name(last_mode),
+                               control::mode_name(mode));
+    last_mode = mode;
+    if (r.stairs_climbed_now)
+      std::cout << fmt::format("  t={:6.2f} s  event: stairs climbed (energy on stairs {:.1f} J)\n", t,
+                               env.stairs_energy());
+    if (r.scene_label != last_label)
+      std::cout << fmt::format("  t={:6.2f} s  event: scene label {} -> {}\n", t, last_label, r.scene_label);
+    last_label = r.scene_label;
+    if (env.step_count() % 100 == 0 || env.done()) {
+      const task::Metrics m = env.metrics();
+      std::cout << fmt::format(
+          "  t={:6.2f} s  step {:4d}  pos ({:5.2f}, {:5.2f}, {:4.2f}) m  to target {:5.2f} m  energy {:7.1f} J "
+          "({:4.1f} W/module)  R1 sum {:8.1f}\n",
+          t, env.step_count(), head[0], head[1], head[2], m.initial_distance_m - m.distance_done_m, m.energy_J,
+          m.energy_J / std::max(t, 1e-9) / env.modules(), reward_sum);
+    }
+    if (env.done()) {
+      const task::Metrics m = env.metrics();
+      std::cout << fmt::format("  t={:6.2f} s  event: {} ({})\n", t,
+                               r.reason == task::Termination::success ? "target reached" : "episode ended",
+                               task::termination_name(r.reason));
+      std::cout << fmt::format(
+          "result: {} after {} steps ({:.2f} s), energy {:.1f} J, T {:.3f}, E {:.4f}, D {:.3f}, F {:.3f}, "
+          "R1 sum {:.1f}\n",
+          task::termination_name(r.reason), m.steps, m.time_s, m.energy_J, m.T, m.E, m.D, m.F, reward_sum);
+    }
+  }
+}
+
+comorph::cli::CommandRegistration registration{[](CLI::App& app) {
+  static SimOptions o;
+  auto* exp = app.add_subcommand("export-mjcf", "write the scene with a chain robot as MJCF to stdout");
+  exp->add_option("--modules,-n", o.modules, "number of modules (2..10)")->check(CLI::Range(2, 10));
+  exp->add_option("--stair-height", o.stair_height, "m, step height (0 = drawn from the seed)");
+  exp->add_option("--obstacles", o.obstacles, "K obstacles (-1 = scene default)");
+  exp->add_option("--seed", o.seed, "scene seed");
+  exp->add_option("--variant", o.variant, "standard | mixed");
+  exp->add_option("--config-dir", o.config_dir, "directory of robot/scene/motion/task.yaml");
+  exp->callback([] { run_export(o); });
+
+  auto* table = app.add_subcommand("physics-table",
+                                   "climbing success/time/energy per chain length and stair height (gait search)");
+  table->add_flag("--json", o.json, "print JSON instead of a table");
+  table->add_option("--seeds", o.seeds, "evaluation seeds per row")->check(CLI::Range(1, 50));
+  table->add_flag("--quick", o.quick, "only 2 and 6 modules");
+  table->add_option("--config-dir", o.config_dir, "directory of robot/scene/motion/task.yaml");
+  table->callback([] { run_physics_table(o); });
+
+  auto* demo = app.add_subcommand("demo", "a scripted controller drives the robot through the scenario");
+  demo->add_option("--modules,-n", o.modules, "number of modules (2..10)")->check(CLI::Range(2, 10));
+  demo->add_option("--seed", o.seed, "scene seed");
+  demo->add_option("--stair-height", o.stair_height, "m, step height (0 = drawn from the seed)");
+  demo->add_option("--obstacles", o.obstacles, "K obstacles (-1 = scene default)");
+  demo->add_option("--variant", o.variant, "standard | mixed");
+  demo->add_option("--config-dir", o.config_dir, "directory of robot/scene/motion/task.yaml");
+  demo->callback([] { run_demo(o); });
+}};
+
+}  // namespace

@@ -1,0 +1,115 @@
+// The simulated world of one episode: a chain of N modules in a seeded scene.
+// Read-only compiled models come from a ModelCache; the World keeps its own
+// copy per chain length (the scene written into it at reset) and one mjData
+// per chain length, so reset() and reconfigure() never recompile and the
+// control step never allocates.
+#pragma once
+
+#include <mujoco/mujoco.h>
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "sim/model.hpp"
+#include "sim/params.hpp"
+#include "sim/scene.hpp"
+
+namespace comorph::sim {
+
+inline constexpr int kMaxChain = 10;
+
+// Why the physics was declared unstable (0 = stable).
+enum class Instability { none, nan_state, bad_qacc, bad_qpos, bad_qvel };
+
+// Outcome of one control period of physics.
+struct PhysicsStepInfo {
+  bool obstacle_contact = false;  // any robot geom touched an obstacle during the period
+  bool stair_contact = false;     // any robot geom touched a riser/step (informational)
+  Instability instability = Instability::none;
+  double energy_J = 0;            // electrical energy drawn by all modules in the period
+};
+
+class World {
+ public:
+  World(const RobotParams& robot, const SceneParams& scene, std::shared_ptr<ModelCache> cache = nullptr);
+
+  // New episode: writes the layout into the model for `modules`, puts the chain
+  // at the layout's start pose at rest, refills the batteries.
+  void reset(const SceneLayout& layout, int modules);
+
+  // Runs control_period / physics_timestep mj_step calls with `ctrl` held
+  // (kActuatorsPerModule values per module, see mjcf.hpp), accounting energy,
+  // contacts and instability. Stops early when the physics becomes unstable.
+  PhysicsStepInfo step_control(const double* ctrl);
+
+  // Sheds tail modules: switches to the cached model with `modules` < modules()
+  // and copies time, the kept modules' qpos, qvel, ctrl and warm start exactly.
+  void reconfigure(int modules);
+
+  // ---- sensors (scene geoms only: the robot never occludes itself) ----
+  // Depth image from module 1's camera, row-major depth_height x depth_width,
+  // planar depth / depth_max_range clipped to [0.01, 1] (1 = nothing in range).
+  void render_depth(float* out) const;
+  // The same camera placed at an arbitrary pose: the camera's position (m, scene
+  // frame) and the heading (yaw, rad) and pitch-up (rad) of the module carrying it.
+  void render_depth_at(const double pos[3], double yaw, double pitch, float* out) const;
+  // Left and right distance per module, normalised by distance_range, in [0, 1]:
+  // out[2k] = left of module k, out[2k+1] = right (1 = nothing within range).
+  void read_distances(float* out) const;
+  // Nearest scene hit along a ray (m), or -1 (same geoms as the sensors).
+  double cast_ray(const double pnt[3], const double dir[3], double max_dist) const;
+
+  // ---- state ----
+  int modules() const { return modules_; }
+  const mjModel* model() const { return model_; }
+  const mjData* data() const { return data_; }
+  mjData* mutable_data() { return data_; }  // for tests and tools; not for the env hot path
+  const SceneLayout& layout() const { return layout_; }
+  const RobotParams& robot_params() const { return robot_; }
+  const SceneParams& scene_params() const { return scene_; }
+  double time() const { return data_->time; }
+  // Module k (0-based): body position (m) and rotation matrix (row-major 3x3).
+  const double* module_pos(int k) const { return data_->xpos + 3 * module_body_[k]; }
+  const double* module_mat(int k) const { return data_->xmat + 9 * module_body_[k]; }
+  double module_up_z(int k) const { return module_mat(k)[8]; }  // world z of the module's z axis
+  double heading() const;                                       // module 1 yaw, rad
+  const double* module_energy() const { return energy_.data(); }  // J drawn per module this episode
+  double energy_used() const;                                     // J, all modules (shed ones included)
+  double battery_fraction(int k) const;                           // remaining, 0..1
+  int substeps() const { return substeps_; }
+  int compilations() const { return cache_->compilations(); }
+  int body_of_module(int k) const { return module_body_[k]; }
+
+ private:
+  struct PerChain {  // one per module count, made on first use
+    ModelPtr model;
+    DataPtr data;
+    std::array<int, kMaxChain> module_body{};
+  };
+  PerChain& chain(int modules);
+  void bind(int modules);
+  double ray_scene(const double pnt[3], const double dir[3], double max_dist) const;
+
+  RobotParams robot_;
+  SceneParams scene_;
+  std::shared_ptr<ModelCache> cache_;
+  std::array<std::unique_ptr<PerChain>, kMaxChain + 1> chains_;
+  std::array<bool, kMaxChain + 1> layout_applied_{};
+  SceneLayout layout_;
+  int modules_ = 0;
+  mjModel* model_ = nullptr;
+  mjData* data_ = nullptr;
+  std::array<int, kMaxChain> module_body_{};
+  int substeps_ = 16;
+  int first_obstacle_geom_ = -1, first_step_geom_ = -1, target_geom_ = -1, floor_geom_ = -1;
+  std::array<double, kMaxChain> energy_{};
+  double shed_energy_ = 0;  // J drawn by modules that were shed
+  // Depth rays in the camera-carrier frame (x forward, y left, z up), unit length.
+  std::vector<double> ray_dirs_;
+  std::vector<double> ray_forward_dot_;  // dir . optical axis, for planar depth
+};
+
+const char* instability_name(Instability i);
+
+}  // namespace comorph::sim

@@ -1,0 +1,36 @@
+// Everything an episode of the multi-task scenario depends on, in one struct
+// with documented defaults (units on every field), loadable from configs/sim/.
+#pragma once
+
+#include <string>
+
+#include "control/motion_modes.hpp"
+#include "sim/params.hpp"
+#include "task/rewards.hpp"
+
+namespace comorph::task {
+
+struct TaskParams {
+  R1Params r1;                 // Eq. 6
+  R2Params r2;                 // Eq. 7
+  ObjectiveWeights objective;  // Eq. 1
+  int max_steps = 3500;        // control steps before truncation (~112 s at 32 ms)
+  double overturn_up_z = 0.2;  // a module whose up axis has a world z below this is overturned (~78 deg tilt)
+  double start_zone_length = 3.0;  // m behind the start face the robot may back up before leaving the area
+  double stair_goal_offset = 0.6;  // m past the top edge: the goal while the stairs are not yet climbed
+};
+
+struct EnvConfig {
+  sim::RobotParams robot;
+  sim::SceneParams scene;
+  control::MotionParams motion;
+  TaskParams task;
+};
+
+// Loads <dir>/robot.yaml, scene.yaml, motion.yaml and task.yaml (each optional:
+// a missing file keeps the defaults). Errors name the file and the field.
+EnvConfig load_env_config(const std::string& dir);
+TaskParams task_params_from_yaml(const std::string& text, const std::string& source_name,
+                                 TaskParams defaults = {});
+
+}  // namespace comorph::task

@@ -1,0 +1,152 @@
+// The multi-task episode (paper Fig. 8): climb the stairs, cross the obstacle
+// field, reach the target. MuJoCo-style split: the EnvConfig and the compiled
+// models are read-only; the env holds the mutable episode state. No torch:
+// observations are plain float buffers the learner copies into tensors.
+//
+// Per control step (32 ms): action (5 floats in [-1, 1]) + motion mode ->
+// Eq. 4/5 motor commands -> 16 x mj_step -> sensors, termination, R1.
+// The hot path does not allocate; reset() and reconfigure() never recompile
+// (models are compiled once per chain length and cached).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "control/motion_modes.hpp"
+#include "sim/scene.hpp"
+#include "sim/world.hpp"
+#include "task/env_config.hpp"
+
+namespace comorph::task {
+
+enum class Termination : int {
+  none = 0,
+  success,           // module 1 within target_radius of the target (r_g)
+  collision,         // a robot geom touched an obstacle (r_u)
+  overturned,        // a module tilted past overturn_up_z (r_u)
+  left_area,         // left the stair lane / flat area sideways or fell off it (r_u)
+  battery_empty,     // a module's battery is empty (r_u)
+  physics_unstable,  // NaN or a MuJoCo bad-qacc/qpos/qvel warning (r_u)
+  step_cap,          // max_steps reached (truncation, no r_u)
+};
+const char* termination_name(Termination t);
+
+struct EpisodeSpec {
+  std::uint64_t seed = 0;    // draws the scene (stair height, obstacles, target, start noise)
+  int modules = 4;           // chain length 2..10
+  double stair_height = 0;   // m; <= 0 draws it from the seed
+  int obstacles = -1;        // K; < 0 takes SceneParams::obstacles
+  sim::Variant variant = sim::Variant::standard;
+};
+
+struct StepResult {
+  double reward = 0;          // R1 of this step (Eq. 6)
+  bool terminated = false;    // success or failure
+  bool truncated = false;     // step cap
+  Termination reason = Termination::none;
+  int scene_label = 0;        // ground truth after the step (sim::SceneLabel)
+  bool stairs_climbed_now = false;  // the r_s event happened in this step
+  double energy_J = 0;        // J drawn in this step
+  double progress_m = 0;      // dD: m closer to the current goal
+  double cos_beta = 0;        // heading term of R1
+};
+
+// Metrics of the episode so far (Eq. 1).
+struct Metrics {
+  int steps = 0;                 // control steps taken
+  double time_s = 0;             // simulated s
+  double energy_J = 0;           // J drawn by all modules (shed ones included)
+  double initial_distance_m = 0; // start -> target, horizontal
+  double distance_done_m = 0;    // initial - current distance to the target, >= 0
+  double T = 0;                  // time_s / (max_steps * control_period)
+  double E = 0;                  // energy_J / (initial modules * battery_capacity)
+  double D = 0;                  // distance_done_m / initial_distance_m, in [0, 1]
+  double F = 0;                  // Eq. 1 with TaskParams::objective
+};
+
+// Layout of the state vector (floats). Modules beyond the chain are zero and masked.
+namespace obs {
+inline constexpr int kBattery = 0;       // 1: mean remaining battery fraction of the modules, 0..1
+inline constexpr int kPosition = 1;      // 3: module 1 position x, y, z (m, scene frame)
+inline constexpr int kVelocity = 4;      // 2: module 1 velocity vx, vy (m/s, scene frame)
+inline constexpr int kPrevReward = 6;    // 1: R1 of the previous step
+inline constexpr int kPrevAction = 7;    // 5: previous action
+inline constexpr int kDistances = 12;    // 20: left, right distance of module k at 12 + 2k (0..1 of range)
+inline constexpr int kModuleMask = 32;   // 10: 1 for modules present
+inline constexpr int kGoal = 42;         // 3: cos, sin of the goal bearing relative to the heading; distance (m)
+inline constexpr int kMode = 45;         // 1: motion mode of the last step (0 flat, 1 stair, 2 narrow)
+inline constexpr int kStateSize = 46;
+}  // namespace obs
+
+class MultiTaskEnv {
+ public:
+  explicit MultiTaskEnv(const EnvConfig& config, std::shared_ptr<sim::ModelCache> cache = nullptr);
+
+  // New episode; observations are valid after it.
+  void reset(const EpisodeSpec& spec);
+  // One control step with the given motion mode. Throws std::logic_error after the episode ended.
+  const StepResult& step(const float* action, control::MotionMode mode);
+  // The same with default_mode() (ground truth) for scripted use.
+  const StepResult& step(const float* action) { return step(action, default_mode()); }
+  // Sheds tail modules (only to fewer, >= 2); carries the kept modules' state exactly.
+  void reconfigure(int modules);
+
+  // stair while the stairs are not climbed and module 1 is not past them, else flat.
+  control::MotionMode default_mode() const;
+
+  // ---- observations (valid until the next step/reset) ----
+  const float* depth() const { return depth_.data(); }  // 1 x H x W, row-major, [0.01, 1]
+  int depth_width() const { return config_.robot.depth_width; }
+  int depth_height() const { return config_.robot.depth_height; }
+  const float* state() const { return state_.data(); }  // obs::kStateSize floats
+  int scene_label() const { return label_; }           // sim::SceneLabel of module 1's position
+
+  // ---- episode bookkeeping for R2 and evaluation ----
+  Metrics metrics() const;
+  bool on_stairs() const { return on_stairs_; }             // some module on the stairs, not yet climbed
+  bool stairs_climbed() const { return climbed_step_ >= 0; }
+  int stairs_climbed_step() const { return climbed_step_; }  // control step of the r_s event, -1 if not yet
+  double stairs_energy() const { return stairs_energy_; }   // J drawn while on_stairs (E_c)
+  double stair_height() const { return world_.layout().stair_height; }
+  int modules() const { return world_.modules(); }
+  int initial_modules() const { return initial_modules_; }
+  int step_count() const { return steps_; }
+  bool done() const { return done_; }
+  const StepResult& last() const { return result_; }
+  control::MotionMode mode() const { return mode_; }
+  void goal(double& x, double& y) const;                    // current goal (m)
+
+  const sim::World& world() const { return world_; }
+  sim::World& mutable_world() { return world_; }  // tools and tests (e.g. depth from arbitrary poses)
+  const EnvConfig& config() const { return config_; }
+
+ private:
+  void update_observation();
+  double goal_distance() const;
+  bool check_climbed() const;
+  bool any_module_on_stairs() const;
+  Termination check_failure(const sim::PhysicsStepInfo& info) const;
+
+  EnvConfig config_;
+  sim::World world_;
+  control::MotorCommand command_;
+  std::array<double, 4 * sim::kMaxChain> ctrl_{};
+  std::vector<float> depth_;
+  std::array<float, obs::kStateSize> state_{};
+  std::array<float, control::kActionSize> prev_action_{};
+  std::array<float, 2 * sim::kMaxChain> distances_{};
+  StepResult result_;
+  control::MotionMode mode_ = control::MotionMode::flat;
+  int initial_modules_ = 0;
+  int steps_ = 0;
+  int label_ = 0;
+  int climbed_step_ = -1;
+  bool on_stairs_ = false;
+  bool done_ = false;
+  double stairs_energy_ = 0;
+  double initial_distance_ = 0;
+};
+
+}  // namespace comorph::task

@@ -1,0 +1,44 @@
+// Rewards and the objective of the multi-task episode (paper Eq. 1, 6, 7).
+#pragma once
+
+#include <string>
+
+namespace comorph::task {
+
+// R1 (Eq. 6), per control step: tau1 * dD + tau2 * cos(beta) + tau3 * r_u + tau4 * r_g,
+// tau4 = 1 + alpha_g * (1 - t / t_sum) (read as a bonus for finishing early).
+struct R1Params {
+  double tau1 = 100.0;     // per m of progress towards the current goal
+  double tau2 = 0.05;      // heading term weight
+  double tau3 = 1.0;       // failure term weight
+  double r_u = -10.0;      // failure reward (collision, overturn, leaving the area, empty battery, unstable)
+  double r_g = 100.0;      // reward on reaching the target
+  double alpha_g = 1.0;    // early-finish bonus weight in tau4
+  double t_sum = 3500.0;   // control steps, normaliser of tau4
+};
+
+// R2 (Eq. 7), per configuration decision over its segment:
+// sigma1 * sum(R1) + sigma2 * r_s + sigma3 * r_c with r_c = -E_c (a cost).
+// On stairs: sigma1 = 1, sigma2 = 1 + s_ht / s_base, sigma3 = 0.003; after: sigma2 = sigma3 = 0.
+struct R2Params {
+  double sigma1 = 1.0;     // weight of the summed R1
+  double s_base = 0.04;    // m, stair height normaliser of sigma2
+  double r_s = 60.0;       // reward when the stairs are climbed in the segment
+  double sigma3 = 0.003;   // per J of stair energy
+};
+
+// Eq. 7 for one segment. stairs_segment: the segment started before the stairs
+// were climbed; stairs_climbed: r_s was earned in it; stair_energy_J: E_c, the
+// joules spent on the stairs during the segment.
+double r2_reward(const R2Params& p, double sum_r1, bool stairs_segment, bool stairs_climbed,
+                 double stair_height_m, double stair_energy_J);
+
+// F(H) (Eq. 1) = -w_t * T - w_e * E + w_d * D.
+struct ObjectiveWeights {
+  double w_t = 1.0;  // weight of T = time used / time max
+  double w_e = 1.0;  // weight of E = energy used / (N * battery capacity)
+  double w_d = 1.0;  // weight of D = distance done / initial distance
+};
+double objective(const ObjectiveWeights& w, double T, double E, double D);
+
+}  // namespace comorph::task

@@ -1,0 +1,110 @@
+#include "task/scripted_pilot.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+
+namespace comorph::task {
+namespace {
+double wrap(double a) {
+  while (a > M_PI) a -= 2 * M_PI;
+  while (a < -M_PI) a += 2 * M_PI;
+  return a;
+}
+}  // namespace
+
+void ScriptedPilot::plan(const MultiTaskEnv& env) {
+  const sim::SceneLayout& s = env.world().layout();
+  const sim::SceneParams& sp = env.config().scene;
+  x0_ = s.platform_x;
+  y0_ = -0.5 * sp.area_width;
+  nx_ = int(std::ceil(sp.area_length / cell_)) + 1;
+  ny_ = int(std::ceil(sp.area_width / cell_)) + 1;
+  field_.assign(std::size_t(nx_) * ny_, -1.0);
+  std::vector<char> blocked(field_.size(), 0);
+  for (int i = 0; i < nx_; ++i)
+    for (int j = 0; j < ny_; ++j) {
+      const double x = x0_ + i * cell_, y = y0_ + j * cell_;
+      bool b = std::abs(y) > 0.5 * sp.area_width - 0.3;
+      for (const sim::Box& o : s.obstacles)
+        b = b || (std::abs(x - o.x) < o.hx + p_.clearance && std::abs(y - o.y) < o.hy + p_.clearance);
+      blocked[std::size_t(i) * ny_ + j] = b;
+    }
+  // Dijkstra from the target, 8-connected.
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  const int ti = std::clamp(int(std::lround((s.target_x - x0_) / cell_)), 0, nx_ - 1);
+  const int tj = std::clamp(int(std::lround((s.target_y - y0_) / cell_)), 0, ny_ - 1);
+  field_[std::size_t(ti) * ny_ + tj] = 0;
+  queue.push({0, ti * ny_ + tj});
+  while (!queue.empty()) {
+    const auto [d, id] = queue.top();
+    queue.pop();
+    if (d > field_[id]) continue;
+    const int i = id / ny_, j = id % ny_;
+    for (int di = -1; di <= 1; ++di)
+      for (int dj = -1; dj <= 1; ++dj) {
+        const int a = i + di, b = j + dj;
+        if ((!di && !dj) || a < 0 || b < 0 || a >= nx_ || b >= ny_) continue;
+        const int n = a * ny_ + b;
+        if (blocked[n]) continue;
+        const double nd = d + cell_ * ((di && dj) ? M_SQRT2 : 1.0);
+        if (field_[n] < 0 || nd < field_[n]) {
+          field_[n] = nd;
+          queue.push({nd, n});
+        }
+      }
+  }
+}
+
+void ScriptedPilot::act(const MultiTaskEnv& env, float a[control::kActionSize],
+                        control::MotionMode& mode) const {
+  const double* head = env.world().module_pos(0);
+  const double heading = env.world().heading();
+  mode = env.default_mode();
+  double gx, gy;
+  env.goal(gx, gy);
+  if (env.stairs_climbed() && !field_.empty()) {
+    // Walk down the distance field from module 1's cell for `lookahead` metres.
+    int i = std::clamp(int(std::lround((head[0] - x0_) / cell_)), 0, nx_ - 1);
+    int j = std::clamp(int(std::lround((head[1] - y0_) / cell_)), 0, ny_ - 1);
+    const int hops = int(p_.lookahead / cell_);
+    for (int h = 0; h < hops; ++h) {
+      int bi = i, bj = j;
+      double best = field_[std::size_t(i) * ny_ + j];
+      if (best < 0) best = 1e9;
+      for (int di = -1; di <= 1; ++di)
+        for (int dj = -1; dj <= 1; ++dj) {
+          const int x = i + di, y = j + dj;
+          if (x < 0 || y < 0 || x >= nx_ || y >= ny_) continue;
+          const double f = field_[std::size_t(x) * ny_ + y];
+          if (f >= 0 && f < best) best = f, bi = x, bj = y;
+        }
+      if (bi == i && bj == j) break;
+      i = bi;
+      j = bj;
+    }
+    gx = x0_ + i * cell_;
+    gy = y0_ + j * cell_;
+    if (std::hypot(env.world().layout().target_x - head[0], env.world().layout().target_y - head[1]) < p_.lookahead) {
+      gx = env.world().layout().target_x;
+      gy = env.world().layout().target_y;
+    }
+  }
+  const double error = wrap(std::atan2(gy - head[1], gx - head[0]) - heading);
+  a[1] = float(std::clamp(p_.heading_gain * error, -1.0, 1.0));
+  if (mode == control::MotionMode::stair) {
+    a[0] = p_.gait.speed;
+    a[2] = p_.gait.amp_front;
+    a[3] = p_.gait.phase;
+    a[4] = p_.gait.amp_back;
+  } else {
+    const double turn = std::abs(error);
+    a[0] = float(turn > p_.slow_turn_error ? 0.0 : std::cos(turn) * (1.0 - turn / p_.slow_turn_error * 0.7));
+    a[2] = -1.0f;
+    a[3] = 0.0f;
+    a[4] = -1.0f;
+  }
+}
+
+}  // namespace comorph::task

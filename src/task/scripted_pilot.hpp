@@ -1,0 +1,46 @@
+// A scripted (not learned) controller for the demo and the physics table. It
+// uses ground truth: while the stairs are not climbed it drives straight up
+// them in stair mode with a fixed gait; then it follows a path planned on the
+// known obstacle layout (grid distance field) in flat mode.
+#pragma once
+
+#include <vector>
+
+#include "control/motion_modes.hpp"
+#include "task/multitask_env.hpp"
+
+namespace comorph::task {
+
+struct StairGait {  // stair-mode action (Eq. 4/5 inputs), held while climbing
+  float speed = 1.0f;       // a0
+  float amp_front = 0.0f;   // a2 (-1 = no wave)
+  float phase = 0.5f;       // a3
+  float amp_back = 0.0f;    // a4
+};
+
+struct PilotParams {
+  StairGait gait;               // used in stair mode
+  double heading_gain = 2.5;    // a1 per rad of heading error
+  double lookahead = 0.6;       // m along the planned path
+  double clearance = 0.40;      // m, obstacles inflated by this when planning
+  double slow_turn_error = 0.6; // rad: above this heading error the robot turns before driving
+};
+
+class ScriptedPilot {
+ public:
+  explicit ScriptedPilot(PilotParams params = {}) : p_(params) {}
+  // Plans on the env's current scene; call after env.reset().
+  void plan(const MultiTaskEnv& env);
+  // The action and mode for the env's current state.
+  void act(const MultiTaskEnv& env, float action[control::kActionSize], control::MotionMode& mode) const;
+  PilotParams& params() { return p_; }
+
+ private:
+  PilotParams p_;
+  // Distance-to-target field on a grid over the flat area (m; < 0 blocked).
+  std::vector<double> field_;
+  int nx_ = 0, ny_ = 0;
+  double x0_ = 0, y0_ = 0, cell_ = 0.05;
+};
+
+}  // namespace comorph::task
