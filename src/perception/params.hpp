@@ -39,7 +39,10 @@ struct ClassifierParams {
 struct TrainParams {
   int epochs = 10;               // passes over the training set
   int batch_size = 64;           // images per Adam step
-  double learning_rate = 1e-3;   // Adam step size
+  double learning_rate = 1e-3;   // Adam step size at the start
+  // Cosine decay of the step size from learning_rate to 0 over all batches:
+  // the last epochs settle instead of ending on a noisy step.
+  bool cosine_schedule = true;
   double weight_decay = 1e-4;    // L2 penalty of Adam (1/weight units^2)
   // Fraction of the data held out for evaluation when no separate evaluation
   // dataset is given (0 = no held-out set). The split is seeded.

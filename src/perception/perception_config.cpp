@@ -81,12 +81,13 @@ PerceptionConfig perception_config_from_yaml(const YAML::Node& root, const std::
   }
   if (const YAML::Node n = root["training"]) {
     check_keys(n, source, "training",
-               {"epochs", "batch_size", "learning_rate", "weight_decay", "eval_fraction", "seed",
+               {"epochs", "batch_size", "learning_rate", "cosine_schedule", "weight_decay", "eval_fraction", "seed",
                 "threads", "progress"});
     TrainParams& t = cfg.training;
     read(n, "epochs", source, "training", t.epochs);
     read(n, "batch_size", source, "training", t.batch_size);
     read(n, "learning_rate", source, "training", t.learning_rate);
+    read(n, "cosine_schedule", source, "training", t.cosine_schedule);
     read(n, "weight_decay", source, "training", t.weight_decay);
     read(n, "eval_fraction", source, "training", t.eval_fraction);
     read(n, "seed", source, "training", t.seed);

@@ -3,7 +3,7 @@
 // out-of-range values throw std::runtime_error naming the source and the key.
 //
 //   classifier:      {image_size, classes, class_names, width, device}
-//   training:        {epochs, batch_size, learning_rate, weight_decay,
+//   training:        {epochs, batch_size, learning_rate, cosine_schedule, weight_decay,
 //                     eval_fraction, seed, threads, progress}
 //   switch_detector: {interval, window, agreement}
 // Every key is optional; a missing key keeps the default of params.hpp /

@@ -35,7 +35,7 @@ class Rng {
 // nothing (1.0) above it.
 void ground(float* img, int n, Rng& rng) {
   const int horizon = rng.integer(n / 8, n / 3);
-  const double near = rng.uniform(0.05, 0.25), far = rng.uniform(0.6, 0.95);
+  const double near = rng.uniform(0.12, 0.3), far = rng.uniform(0.6, 0.95);
   for (int r = 0; r < n; ++r) {
     double d = 1.0;
     if (r >= horizon) {
@@ -66,11 +66,12 @@ void obstacles(float* img, int n, Rng& rng) {
   ground(img, n, rng);
   const int boxes = rng.integer(1, 3);
   for (int b = 0; b < boxes; ++b) {
-    const int w = rng.integer(std::max(2, n / 8), std::max(3, (3 * n) / 8));
-    const int h = rng.integer(std::max(2, n / 8), std::max(3, (3 * n) / 8));
+    const int w = rng.integer(std::max(3, n / 5), std::max(4, (3 * n) / 8));
+    const int h = rng.integer(std::max(3, n / 5), std::max(4, (3 * n) / 8));
     const int bottom = rng.integer(n / 2, n - 1);
     const int left = rng.integer(0, n - w);
-    const float d = static_cast<float>(std::max(0.02, img[bottom * n + left] - rng.uniform(0.0, 0.05)));
+    // The box's front face is a little nearer than the ground it stands on.
+    const float d = static_cast<float>(std::max(0.01, img[bottom * n + left] - rng.uniform(0.05, 0.12)));
     for (int r = std::max(0, bottom - h + 1); r <= bottom; ++r)
       for (int c = left; c < left + w; ++c) img[r * n + c] = std::min(img[r * n + c], d);
   }

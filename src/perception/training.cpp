@@ -142,6 +142,9 @@ TrainResult train_classifier(const Dataset& data, const ClassifierParams& params
   std::vector<std::int64_t> order(static_cast<std::size_t>(n));
   std::iota(order.begin(), order.end(), 0);
   torch::Tensor index = torch::empty({n}, torch::kInt64);
+  const std::int64_t batches_per_epoch = (n + tp.batch_size - 1) / tp.batch_size;
+  const double total_batches = static_cast<double>(batches_per_epoch) * tp.epochs;
+  std::int64_t batch_number = 0;
 
   for (int epoch = 1; epoch <= tp.epochs; ++epoch) {
     const auto start = std::chrono::steady_clock::now();
@@ -157,6 +160,13 @@ TrainResult train_classifier(const Dataset& data, const ClassifierParams& params
       const torch::Tensor idx = device_index.slice(0, begin, end);
       const torch::Tensor x = train.images.index_select(0, idx);
       const torch::Tensor y = train.labels.index_select(0, idx);
+      if (tp.cosine_schedule) {
+        const double lr = 0.5 * tp.learning_rate *
+                          (1.0 + std::cos(3.141592653589793 * static_cast<double>(batch_number) / total_batches));
+        for (auto& group : optimizer.param_groups())
+          static_cast<torch::optim::AdamOptions&>(group.options()).lr(lr);
+      }
+      ++batch_number;
       optimizer.zero_grad();
       const torch::Tensor logits = m.net->forward(x);
       const torch::Tensor loss = torch::nn::functional::cross_entropy(logits, y);
