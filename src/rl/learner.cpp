@@ -1,0 +1,95 @@
+#include "rl/learner.hpp"
+
+#include <torch/torch.h>
+
+#include <sstream>
+
+namespace comorph::rl {
+
+YamlFields::YamlFields(const YAML::Node& node, std::string source)
+    : node_(node), source_(std::move(source)) {
+  if (node_ && !node_.IsNull() && !node_.IsMap())
+    throw std::invalid_argument(source_ + ": expected a mapping of hyperparameters");
+}
+
+void YamlFields::finish() const {
+  if (!node_ || node_.IsNull()) return;
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.as<std::string>();
+    if (!seen_.count(key))
+      throw std::invalid_argument(source_ + ": unknown field \"" + key + "\"");
+  }
+}
+
+YAML::Node load_yaml_file(const std::string& path) {
+  try {
+    return YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw std::invalid_argument("cannot read YAML file " + path);
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(path + ": " + e.what());
+  }
+}
+
+std::string rl_config_dir() { return std::string(COMORPH_SOURCE_DIR) + "/configs/rl"; }
+
+void check_device_name(const std::string& name) {
+  try {
+    torch::Device device(name);
+    (void)device;
+  } catch (const std::exception&) {
+    throw std::invalid_argument("unknown torch device \"" + name + "\" (use cpu, cuda, cuda:N)");
+  }
+}
+
+void set_torch_threads(int intra_op_threads, int inter_op_threads) {
+  if (intra_op_threads > 0) at::set_num_threads(intra_op_threads);
+  static bool inter_op_set = false;
+  if (inter_op_threads > 0 && !inter_op_set) {
+    try {
+      at::set_num_interop_threads(inter_op_threads);
+    } catch (const std::exception&) {
+      // Already started (the pool is created on first use): keep it.
+    }
+    inter_op_set = true;
+  }
+}
+
+std::string rng_state(const std::mt19937_64& rng) {
+  std::ostringstream out;
+  out << rng;
+  return out.str();
+}
+
+void set_rng_state(std::mt19937_64& rng, const std::string& state) {
+  std::istringstream in(state);
+  in >> rng;
+  if (!in) throw std::runtime_error("checkpoint: corrupt RNG state");
+}
+
+void write_common(torch::serialize::OutputArchive& a, const LearnerCounters& c,
+                  const std::mt19937_64& rng, const std::string& algorithm) {
+  a.write("algorithm", c10::IValue(algorithm));
+  a.write("counters", torch::tensor({c.transitions, c.episodes, c.updates}));
+  a.write("rng", c10::IValue(rng_state(rng)));
+}
+
+void read_common(torch::serialize::InputArchive& a, LearnerCounters& c, std::mt19937_64& rng,
+                 const std::string& algorithm) {
+  c10::IValue name;
+  a.read("algorithm", name);
+  if (name.toStringRef() != algorithm)
+    throw std::runtime_error("checkpoint holds a " + name.toStringRef() + " learner, not " +
+                             algorithm);
+  torch::Tensor t;
+  a.read("counters", t);
+  const auto* v = t.data_ptr<std::int64_t>();
+  c.transitions = v[0];
+  c.episodes = v[1];
+  c.updates = v[2];
+  c10::IValue state;
+  a.read("rng", state);
+  set_rng_state(rng, state.toStringRef());
+}
+
+}  // namespace comorph::rl

@@ -1,0 +1,122 @@
+// What every learner (DQN, TD3, SAC) offers to an outside training loop, and
+// the small pieces they share: counters, RNG, schedules, YAML reading,
+// checkpoint files, device and thread settings.
+//
+// Step-by-step use by a caller that owns the loop (the hierarchical trainer):
+//   learner.act(obs, /*explore=*/true, action);      // InferenceMode inside
+//   ... env step ...
+//   learner.store(obs, action, reward, next_obs, terminated, truncated, k);
+//   for (int i = learner.updates_due(); i > 0; --i) learner.update();  // or when it wants
+// A transition may stand for k environment steps (a semi-MDP segment): it is
+// then discounted by gamma^k.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdint>
+#include <random>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "rl/env.hpp"
+
+namespace torch::serialize {
+class OutputArchive;
+class InputArchive;
+}  // namespace torch::serialize
+
+namespace comorph::rl {
+
+// Counters every learner keeps; all are part of a checkpoint.
+struct LearnerCounters {
+  std::int64_t transitions = 0;  // store() calls
+  std::int64_t episodes = 0;     // stored transitions that ended an episode
+  std::int64_t updates = 0;      // gradient steps done by update()
+};
+
+class Learner {
+ public:
+  virtual ~Learner() = default;
+  // Chooses an action for one observation. explore=false is the greedy policy.
+  virtual void act(const Observation& observation, bool explore, Action& action) = 0;
+  // Records one transition; `steps` environment steps were taken (discount gamma^steps).
+  virtual void store(const Observation& observation, const Action& action, float reward,
+                     const Observation& next_observation, bool terminated, bool truncated,
+                     int steps = 1) = 0;
+  // Gradient steps the configuration asks for after the latest store()
+  // (train_frequency / gradient_steps / learning_starts); 0 most of the time.
+  virtual int updates_due() const = 0;
+  // One gradient step on a batch sampled from the replay buffer.
+  virtual void update() = 0;
+  // Everything needed to continue exactly: networks, targets, optimizers,
+  // replay buffer, counters, RNG state.
+  virtual void save(const std::string& path) const = 0;
+  virtual void load(const std::string& path) = 0;
+  virtual const LearnerCounters& counters() const = 0;
+  // Loss of the latest update() (critic / Q loss), for logs.
+  virtual double last_loss() const = 0;
+};
+
+// Linear interpolation from `start` to `end` over `duration` units, then `end`.
+struct LinearSchedule {
+  double start = 1.0;
+  double end = 1.0;
+  double duration = 0.0;  // 0 = always `end`
+  double at(double t) const {
+    if (duration <= 0.0 || t >= duration) return end;
+    return start + (end - start) * (t / duration);
+  }
+};
+
+// Reads a YAML mapping into a struct field by field and rejects unknown keys,
+// naming the file and the key: a misspelt hyperparameter must not be ignored.
+class YamlFields {
+ public:
+  YamlFields(const YAML::Node& node, std::string source);
+  template <typename T>
+  void read(const std::string& key, T& field) {
+    seen_.insert(key);
+    const YAML::Node value = node_[key];
+    if (!value) return;  // keep the default
+    try {
+      field = value.as<T>();
+    } catch (const YAML::Exception& e) {
+      throw std::invalid_argument(source_ + ": field \"" + key + "\" has a bad value: " + e.what());
+    }
+  }
+  void finish() const;  // throws on any key that was not read
+  const std::string& source() const { return source_; }
+
+ private:
+  YAML::Node node_;
+  std::string source_;
+  std::set<std::string> seen_;
+};
+
+// Loads a YAML file (throws with the path on error).
+YAML::Node load_yaml_file(const std::string& path);
+
+// Where the YAML presets are: <source dir>/configs/rl.
+std::string rl_config_dir();
+
+// "cpu", "cuda", "cuda:1" -> torch device; throws with the name if unknown.
+// (Declared with a string to keep torch out of this header.)
+void check_device_name(const std::string& name);
+
+// Sets the intra-op and inter-op thread counts of torch. The inter-op count
+// can only be set once per process; later calls leave it alone.
+void set_torch_threads(int intra_op_threads, int inter_op_threads);
+
+// RNG state as text (std::mt19937_64's stream format), for checkpoints.
+std::string rng_state(const std::mt19937_64& rng);
+void set_rng_state(std::mt19937_64& rng, const std::string& state);
+
+// Shared checkpoint pieces.
+void write_common(torch::serialize::OutputArchive& archive, const LearnerCounters& counters,
+                  const std::mt19937_64& rng, const std::string& algorithm);
+void read_common(torch::serialize::InputArchive& archive, LearnerCounters& counters,
+                 std::mt19937_64& rng, const std::string& algorithm);
+
+}  // namespace comorph::rl

@@ -1,0 +1,213 @@
+#include "rl/replay_buffer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace comorph::rl {
+
+ImageStorage image_storage_from_string(const std::string& name) {
+  if (name == "uint8") return ImageStorage::kUint8;
+  if (name == "float16") return ImageStorage::kFloat16;
+  throw std::invalid_argument("image_storage must be \"uint8\" or \"float16\", got \"" + name + "\"");
+}
+
+ReplayBuffer::ReplayBuffer(ObservationSpec observation, ActionSpec action, std::int64_t capacity,
+                           ImageStorage image_storage)
+    : obs_spec_(observation), action_spec_(action), capacity_(capacity), image_storage_(image_storage) {
+  if (capacity <= 0) throw std::invalid_argument("ReplayBuffer: capacity must be > 0");
+  if (!observation.has_image() && !observation.has_vector())
+    throw std::invalid_argument("ReplayBuffer: observation has neither image nor vector");
+  const auto f32 = torch::TensorOptions().dtype(torch::kFloat32);
+  if (observation.has_image()) {
+    const auto dtype = image_storage == ImageStorage::kUint8 ? torch::kUInt8 : torch::kFloat16;
+    const std::vector<std::int64_t> shape{capacity, observation.image_channels,
+                                          observation.image_height, observation.image_width};
+    image_ = torch::zeros(shape, torch::TensorOptions().dtype(dtype));
+    next_image_ = torch::zeros(shape, torch::TensorOptions().dtype(dtype));
+  }
+  if (observation.has_vector()) {
+    vector_ = torch::zeros({capacity, observation.vector_size}, f32);
+    next_vector_ = torch::zeros({capacity, observation.vector_size}, f32);
+  }
+  if (action.kind == ActionKind::kDiscrete) {
+    action_ = torch::zeros({capacity}, torch::TensorOptions().dtype(torch::kInt64));
+    next_valid_ = torch::ones({capacity, action.size}, torch::TensorOptions().dtype(torch::kBool));
+  } else {
+    action_ = torch::zeros({capacity, action.size}, f32);
+  }
+  reward_ = torch::zeros({capacity}, f32);
+  discount_ = torch::zeros({capacity}, f32);
+  terminated_ = torch::zeros({capacity}, f32);
+}
+
+void ReplayBuffer::store_image(const std::vector<float>& image, torch::Tensor& storage,
+                               std::int64_t slot) {
+  const int n = obs_spec_.image_size();
+  if (static_cast<int>(image.size()) != n)
+    throw std::invalid_argument("ReplayBuffer::add: image has " + std::to_string(image.size()) +
+                                " values, expected " + std::to_string(n));
+  if (image_storage_ == ImageStorage::kUint8) {
+    std::uint8_t* dst = storage.data_ptr<std::uint8_t>() + slot * n;
+    for (int i = 0; i < n; ++i)
+      dst[i] = static_cast<std::uint8_t>(std::lround(std::clamp(image[i], 0.0f, 1.0f) * 255.0f));
+  } else {
+    at::Half* dst = storage.data_ptr<at::Half>() + slot * n;
+    for (int i = 0; i < n; ++i) dst[i] = at::Half(image[i]);
+  }
+}
+
+void ReplayBuffer::add(const Observation& obs, const Action& action, float reward,
+                       const Observation& next, bool terminated, float discount) {
+  const std::int64_t slot = position_;
+  if (obs_spec_.has_image()) {
+    store_image(obs.image, image_, slot);
+    store_image(next.image, next_image_, slot);
+  }
+  if (obs_spec_.has_vector()) {
+    const int v = obs_spec_.vector_size;
+    if (static_cast<int>(obs.vector.size()) != v || static_cast<int>(next.vector.size()) != v)
+      throw std::invalid_argument("ReplayBuffer::add: vector observation must have " +
+                                  std::to_string(v) + " values");
+    std::copy(obs.vector.begin(), obs.vector.end(), vector_.data_ptr<float>() + slot * v);
+    std::copy(next.vector.begin(), next.vector.end(), next_vector_.data_ptr<float>() + slot * v);
+  }
+  if (action_spec_.kind == ActionKind::kDiscrete) {
+    if (action.discrete < 0 || action.discrete >= action_spec_.size)
+      throw std::invalid_argument("ReplayBuffer::add: discrete action " +
+                                  std::to_string(action.discrete) + " outside [0, " +
+                                  std::to_string(action_spec_.size) + ")");
+    action_.data_ptr<std::int64_t>()[slot] = action.discrete;
+    bool* mask = next_valid_.data_ptr<bool>() + slot * action_spec_.size;
+    if (next.valid_actions.empty()) {
+      std::fill(mask, mask + action_spec_.size, true);
+    } else {
+      if (static_cast<int>(next.valid_actions.size()) != action_spec_.size)
+        throw std::invalid_argument("ReplayBuffer::add: valid_actions must have " +
+                                    std::to_string(action_spec_.size) + " entries");
+      for (int i = 0; i < action_spec_.size; ++i) mask[i] = next.valid_actions[i] != 0;
+    }
+  } else {
+    if (static_cast<int>(action.continuous.size()) != action_spec_.size)
+      throw std::invalid_argument("ReplayBuffer::add: continuous action must have " +
+                                  std::to_string(action_spec_.size) + " values");
+    std::copy(action.continuous.begin(), action.continuous.end(),
+              action_.data_ptr<float>() + slot * action_spec_.size);
+  }
+  reward_.data_ptr<float>()[slot] = reward;
+  discount_.data_ptr<float>()[slot] = discount;
+  terminated_.data_ptr<float>()[slot] = terminated ? 1.0f : 0.0f;
+  position_ = (position_ + 1) % capacity_;
+  size_ = std::min(size_ + 1, capacity_);
+}
+
+torch::Tensor ReplayBuffer::images_as_float(const torch::Tensor& storage,
+                                            const torch::Tensor& slots) const {
+  torch::Tensor x = storage.index_select(0, slots).to(torch::kFloat32);
+  if (image_storage_ == ImageStorage::kUint8) x.div_(255.0f);
+  return x;
+}
+
+ReplayBatch ReplayBuffer::gather(const torch::Tensor& slots, const torch::Device& device) const {
+  ReplayBatch b;
+  if (obs_spec_.has_image()) {
+    b.image = images_as_float(image_, slots).to(device);
+    b.next_image = images_as_float(next_image_, slots).to(device);
+  }
+  if (obs_spec_.has_vector()) {
+    b.vector = vector_.index_select(0, slots).to(device);
+    b.next_vector = next_vector_.index_select(0, slots).to(device);
+  }
+  b.action = action_.index_select(0, slots).to(device);
+  b.reward = reward_.index_select(0, slots).to(device);
+  b.bootstrap = (discount_.index_select(0, slots) * (1.0f - terminated_.index_select(0, slots)))
+                    .to(device);
+  if (next_valid_.defined()) b.next_valid_actions = next_valid_.index_select(0, slots).to(device);
+  return b;
+}
+
+ReplayBatch ReplayBuffer::sample(std::int64_t batch_size, std::mt19937_64& rng,
+                                 const torch::Device& device) const {
+  if (size_ == 0) throw std::logic_error("ReplayBuffer::sample: buffer is empty");
+  torch::Tensor slots = torch::empty({batch_size}, torch::TensorOptions().dtype(torch::kInt64));
+  std::int64_t* s = slots.data_ptr<std::int64_t>();
+  std::uniform_int_distribution<std::int64_t> pick(0, size_ - 1);
+  for (std::int64_t i = 0; i < batch_size; ++i) s[i] = pick(rng);
+  return gather(slots, device);
+}
+
+void ReplayBuffer::save(torch::serialize::OutputArchive& a) const {
+  // Only the filled slots are written (a fresh buffer of the same capacity
+  // is rebuilt on load).
+  const std::int64_t n = size_;
+  auto filled = [n](const torch::Tensor& t) { return t.slice(0, 0, n).clone(); };
+  a.write("capacity", torch::tensor({capacity_}));
+  a.write("size", torch::tensor({size_}));
+  a.write("position", torch::tensor({position_}));
+  a.write("image_storage", torch::tensor({static_cast<std::int64_t>(image_storage_)}));
+  if (image_.defined()) {
+    a.write("image", filled(image_));
+    a.write("next_image", filled(next_image_));
+  }
+  if (vector_.defined()) {
+    a.write("vector", filled(vector_));
+    a.write("next_vector", filled(next_vector_));
+  }
+  a.write("action", filled(action_));
+  a.write("reward", filled(reward_));
+  a.write("discount", filled(discount_));
+  a.write("terminated", filled(terminated_));
+  if (next_valid_.defined()) a.write("next_valid", filled(next_valid_));
+}
+
+void ReplayBuffer::load(torch::serialize::InputArchive& a) {
+  torch::Tensor t;
+  a.read("capacity", t);
+  if (t.item<std::int64_t>() != capacity_)
+    throw std::runtime_error("ReplayBuffer::load: saved capacity " +
+                             std::to_string(t.item<std::int64_t>()) + " != this buffer's " +
+                             std::to_string(capacity_));
+  a.read("image_storage", t);
+  if (t.item<std::int64_t>() != static_cast<std::int64_t>(image_storage_))
+    throw std::runtime_error("ReplayBuffer::load: saved image storage type differs");
+  a.read("size", t);
+  size_ = t.item<std::int64_t>();
+  a.read("position", t);
+  position_ = t.item<std::int64_t>();
+  auto restore = [&](const char* key, torch::Tensor& dst) {
+    torch::Tensor src;
+    a.read(key, src);
+    if (src.size(0) != size_ || src.sizes().slice(1) != dst.sizes().slice(1) ||
+        src.scalar_type() != dst.scalar_type())
+      throw std::runtime_error(std::string("ReplayBuffer::load: field \"") + key +
+                               "\" has the wrong shape or type for this buffer");
+    dst.slice(0, 0, size_).copy_(src);
+  };
+  if (image_.defined()) {
+    restore("image", image_);
+    restore("next_image", next_image_);
+  }
+  if (vector_.defined()) {
+    restore("vector", vector_);
+    restore("next_vector", next_vector_);
+  }
+  restore("action", action_);
+  restore("reward", reward_);
+  restore("discount", discount_);
+  restore("terminated", terminated_);
+  if (next_valid_.defined()) restore("next_valid", next_valid_);
+}
+
+void ReplayBuffer::save(const std::string& path) const {
+  torch::serialize::OutputArchive a;
+  save(a);
+  a.save_to(path);
+}
+
+void ReplayBuffer::load(const std::string& path) {
+  torch::serialize::InputArchive a;
+  a.load_from(path);
+  load(a);
+}
+
+}  // namespace comorph::rl

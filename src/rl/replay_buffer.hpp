@@ -1,0 +1,79 @@
+// Uniform experience replay with storage preallocated at construction.
+//
+// Images are stored compactly (uint8, value * 255 rounded, or float16) and
+// converted back to float32 in [0, 1] when a batch is sampled; vectors,
+// actions and rewards are float32 (discrete actions int64). Every transition
+// carries its own discount (gamma^k for a semi-MDP segment of k steps) and its
+// `terminated` flag; the sampled `bootstrap` = discount * (1 - terminated) is
+// what multiplies the next state's value, so a truncated transition (not
+// terminated) still bootstraps. For discrete actions the valid-action mask of
+// the next state is stored too (the DQN target maximises over it).
+//
+// Storage lives on the CPU; sampled batches are moved to `device`.
+#pragma once
+
+#include <torch/torch.h>
+
+#include <cstdint>
+#include <random>
+#include <string>
+
+#include "rl/env.hpp"
+
+namespace comorph::rl {
+
+enum class ImageStorage { kUint8, kFloat16 };
+
+ImageStorage image_storage_from_string(const std::string& name);  // "uint8" | "float16"
+
+struct ReplayBatch {
+  torch::Tensor image, next_image;           // [B, C, H, W] float32, or undefined
+  torch::Tensor vector, next_vector;         // [B, V] float32, or undefined
+  torch::Tensor action;                      // [B, A] float32, or [B] int64 (discrete)
+  torch::Tensor reward;                      // [B] float32
+  torch::Tensor bootstrap;                   // [B] float32: discount, 0 when terminated
+  torch::Tensor next_valid_actions;          // [B, n] bool (discrete), or undefined
+};
+
+class ReplayBuffer {
+ public:
+  ReplayBuffer(ObservationSpec observation, ActionSpec action, std::int64_t capacity,
+               ImageStorage image_storage = ImageStorage::kUint8);
+
+  // Copies one transition into the next slot (overwrites the oldest once full).
+  // `discount` is gamma^k of this transition.
+  void add(const Observation& observation, const Action& action, float reward,
+           const Observation& next_observation, bool terminated, float discount);
+
+  // `batch_size` transitions drawn uniformly with replacement by `rng`.
+  ReplayBatch sample(std::int64_t batch_size, std::mt19937_64& rng,
+                     const torch::Device& device) const;
+  // The transitions at the given slots (tests, debugging).
+  ReplayBatch gather(const torch::Tensor& slots, const torch::Device& device) const;
+
+  std::int64_t size() const { return size_; }
+  std::int64_t capacity() const { return capacity_; }
+  std::int64_t next_slot() const { return position_; }
+  const ObservationSpec& observation_spec() const { return obs_spec_; }
+
+  void save(torch::serialize::OutputArchive& archive) const;
+  void load(torch::serialize::InputArchive& archive);
+  void save(const std::string& path) const;
+  void load(const std::string& path);
+
+ private:
+  void store_image(const std::vector<float>& image, torch::Tensor& storage, std::int64_t slot);
+  torch::Tensor images_as_float(const torch::Tensor& storage, const torch::Tensor& slots) const;
+
+  ObservationSpec obs_spec_;
+  ActionSpec action_spec_;
+  std::int64_t capacity_;
+  ImageStorage image_storage_;
+  std::int64_t size_ = 0;
+  std::int64_t position_ = 0;
+
+  torch::Tensor image_, next_image_, vector_, next_vector_;
+  torch::Tensor action_, reward_, discount_, terminated_, next_valid_;
+};
+
+}  // namespace comorph::rl

@@ -1,0 +1,408 @@
+// Unit tests of the RL core: classic env dynamics, replay buffer, networks,
+// DQN masking, terminated vs truncated, YAML hyperparameters.
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include "rl/classic/cartpole.hpp"
+#include "rl/classic/pendulum.hpp"
+#include "rl/dqn.hpp"
+#include "rl/networks.hpp"
+#include "rl/replay_buffer.hpp"
+#include "rl/sac.hpp"
+#include "rl/td3.hpp"
+#include "rl/train_classic.hpp"
+
+namespace rl = comorph::rl;
+
+namespace {
+
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("comorph_rl_" + name)).string();
+}
+
+rl::Observation vector_obs(std::vector<float> v, std::vector<std::uint8_t> valid = {}) {
+  rl::Observation o;
+  o.vector = std::move(v);
+  o.valid_actions = std::move(valid);
+  return o;
+}
+
+}  // namespace
+
+// ---- classic environments ----------------------------------------------------
+
+TEST(Pendulum, HangingDownAtRestCostsPiSquared) {
+  rl::PendulumParams p;
+  rl::PendulumState s{M_PI, 0.0};
+  const double reward = rl::pendulum_step(p, 0.0, s);
+  EXPECT_NEAR(reward, -M_PI * M_PI, 1e-12);
+  EXPECT_NEAR(s.theta_dot, 15.0 * std::sin(M_PI) * 0.05, 1e-12);
+}
+
+TEST(Pendulum, ClipsTorqueAndSpeedAndUsesSemiImplicitEuler) {
+  rl::PendulumParams p;
+  rl::PendulumState s{M_PI / 2, 7.9};
+  // u = 5 is clipped to 2: thdot = 7.9 + (15 + 6) * 0.05 = 8.95 -> clipped to 8.
+  const double reward = rl::pendulum_step(p, 5.0, s);
+  EXPECT_DOUBLE_EQ(s.theta_dot, 8.0);
+  EXPECT_NEAR(s.theta, M_PI / 2 + 8.0 * 0.05, 1e-12);
+  EXPECT_NEAR(reward, -((M_PI / 2) * (M_PI / 2) + 0.1 * 7.9 * 7.9 + 0.001 * 4.0), 1e-12);
+}
+
+TEST(Pendulum, AngleNormalizeMatchesPythonModulo) {
+  EXPECT_NEAR(rl::angle_normalize(M_PI), -M_PI, 1e-12);
+  EXPECT_NEAR(rl::angle_normalize(3 * M_PI / 2), -M_PI / 2, 1e-12);
+  EXPECT_NEAR(rl::angle_normalize(-3 * M_PI / 2), M_PI / 2, 1e-12);
+  EXPECT_NEAR(rl::angle_normalize(0.3), 0.3, 1e-12);
+}
+
+TEST(Pendulum, EnvScalesActionObservesAndTruncatesAt200) {
+  rl::PendulumEnv env;
+  env.seed(3);
+  rl::Observation o;
+  env.reset(o);
+  ASSERT_EQ(o.vector.size(), 3u);
+  EXPECT_LE(std::abs(env.state().theta), M_PI);
+  EXPECT_LE(std::abs(env.state().theta_dot), 1.0);
+  env.set_state({0.0, 0.0});
+  rl::Action a;
+  a.continuous = {1.0f};  // normalised 1 = 2 N m
+  rl::StepResult r = env.step(a, o);
+  EXPECT_NEAR(env.state().theta_dot, 3.0 * 2.0 * 0.05, 1e-12);
+  EXPECT_NEAR(o.vector[0], std::cos(env.state().theta), 1e-6);
+  EXPECT_NEAR(o.vector[1], std::sin(env.state().theta), 1e-6);
+  EXPECT_NEAR(r.reward, -0.001 * 4.0, 1e-7);
+  int steps = 1;
+  while (!r.truncated) {
+    EXPECT_FALSE(r.terminated);
+    r = env.step(a, o);
+    ++steps;
+  }
+  EXPECT_EQ(steps, 200);
+  EXPECT_FALSE(r.terminated);
+}
+
+TEST(CartPole, OneStepFromRestMatchesHandComputedEuler) {
+  rl::CartPoleParams p;
+  rl::CartPoleState s{0, 0, 0, 0};
+  EXPECT_FALSE(rl::cartpole_step(p, 1, s));
+  // temp = 10/1.1; thetaacc = -temp / (0.5 (4/3 - 0.1/1.1)); xacc = temp - 0.05 thetaacc / 1.1
+  const double temp = 10.0 / 1.1;
+  const double thetaacc = -temp / (0.5 * (4.0 / 3.0 - 0.1 / 1.1));
+  const double xacc = temp - 0.05 * thetaacc / 1.1;
+  EXPECT_DOUBLE_EQ(s[0], 0.0);
+  EXPECT_NEAR(s[1], 0.02 * xacc, 1e-12);
+  EXPECT_NEAR(s[1], 0.195122, 1e-6);
+  EXPECT_DOUBLE_EQ(s[2], 0.0);
+  EXPECT_NEAR(s[3], -0.292683, 1e-6);
+}
+
+TEST(CartPole, TerminatesWhenPoleFallsWithRewardOne) {
+  rl::CartPoleEnv env;
+  env.seed(1);
+  rl::Observation o;
+  env.reset(o);
+  for (double v : o.vector) EXPECT_LE(std::abs(v), 0.05);
+  rl::Action a;
+  a.discrete = 1;
+  rl::StepResult r;
+  int steps = 0;
+  do {
+    r = env.step(a, o);
+    EXPECT_EQ(r.reward, 1.0f);
+    ++steps;
+  } while (!r.terminated && !r.truncated);
+  EXPECT_TRUE(r.terminated);
+  EXPECT_FALSE(r.truncated);
+  EXPECT_GT(std::abs(env.state()[2]), 12.0 * 2.0 * M_PI / 360.0);
+  EXPECT_LT(steps, 50);
+}
+
+TEST(CartPole, TruncatesAt500WithoutTermination) {
+  rl::CartPoleParams p;
+  p.theta_threshold = 1e9;  // never fails
+  p.x_threshold = 1e9;
+  rl::CartPoleEnv env(p);
+  rl::Observation o;
+  env.reset(o);
+  rl::Action a;
+  a.discrete = 0;
+  int steps = 0;
+  rl::StepResult r;
+  do {
+    r = env.step(a, o);
+    ++steps;
+  } while (!r.terminated && !r.truncated);
+  EXPECT_EQ(steps, 500);
+  EXPECT_TRUE(r.truncated);
+  EXPECT_FALSE(r.terminated);
+}
+
+// ---- replay buffer -------------------------------------------------------------
+
+TEST(ReplayBuffer, WrapsAroundOverwritingTheOldest) {
+  rl::ReplayBuffer buffer({0, 0, 0, 2}, {rl::ActionKind::kContinuous, 1}, 5);
+  rl::Action a;
+  for (int i = 0; i < 12; ++i) {
+    a.continuous = {static_cast<float>(i) / 100};
+    buffer.add(vector_obs({float(i), 0}), a, float(i), vector_obs({float(i + 1), 0}), false, 0.9f);
+  }
+  EXPECT_EQ(buffer.size(), 5);
+  EXPECT_EQ(buffer.next_slot(), 12 % 5);
+  const rl::ReplayBatch b = buffer.gather(torch::arange(5), torch::kCPU);
+  const std::vector<float> expected{10, 11, 7, 8, 9};
+  for (int s = 0; s < 5; ++s) {
+    EXPECT_EQ(b.reward[s].item<float>(), expected[s]);
+    EXPECT_EQ(b.vector[s][0].item<float>(), expected[s]);
+    EXPECT_EQ(b.next_vector[s][0].item<float>(), expected[s] + 1);
+    EXPECT_FLOAT_EQ(b.action[s][0].item<float>(), expected[s] / 100);
+  }
+  // Sampling never returns a slot outside the filled range.
+  std::mt19937_64 rng(1);
+  const rl::ReplayBatch sample = buffer.sample(200, rng, torch::kCPU);
+  EXPECT_GE(sample.reward.min().item<float>(), 7);
+}
+
+TEST(ReplayBuffer, TerminatedDoesNotBootstrapTruncatedDoes) {
+  rl::ReplayBuffer buffer({0, 0, 0, 1}, {rl::ActionKind::kDiscrete, 3}, 8);
+  rl::Action a;
+  a.discrete = 2;
+  buffer.add(vector_obs({0}), a, 1.0f, vector_obs({1}), /*terminated=*/true, 0.99f);
+  buffer.add(vector_obs({0}), a, 1.0f, vector_obs({1}), /*terminated=*/false, 0.99f);  // truncated
+  buffer.add(vector_obs({0}), a, 1.0f, vector_obs({1}, {0, 1, 0}), false, std::pow(0.99f, 4));
+  const rl::ReplayBatch b = buffer.gather(torch::arange(3), torch::kCPU);
+  EXPECT_EQ(b.bootstrap[0].item<float>(), 0.0f);
+  EXPECT_FLOAT_EQ(b.bootstrap[1].item<float>(), 0.99f);
+  EXPECT_FLOAT_EQ(b.bootstrap[2].item<float>(), std::pow(0.99f, 4));
+  EXPECT_EQ(b.action[0].item<std::int64_t>(), 2);
+  EXPECT_TRUE(b.next_valid_actions[1].all().item<bool>());  // empty mask = all valid
+  EXPECT_FALSE(b.next_valid_actions[2][0].item<bool>());
+  EXPECT_TRUE(b.next_valid_actions[2][1].item<bool>());
+}
+
+TEST(ReplayBuffer, StoresImagesCompactlyAndSavesAndLoads) {
+  const rl::ObservationSpec spec{1, 4, 4, 2};
+  for (const auto storage : {rl::ImageStorage::kUint8, rl::ImageStorage::kFloat16}) {
+    rl::ReplayBuffer buffer(spec, {rl::ActionKind::kContinuous, 2}, 10, storage);
+    rl::Observation o, n;
+    rl::allocate(spec, o);
+    rl::allocate(spec, n);
+    rl::Action a;
+    a.continuous = {0.5f, -0.5f};
+    for (int i = 0; i < 16; ++i) {
+      o.image[i] = 0.01f + 0.99f * i / 15.0f;  // depth range [0.01, 1]
+      n.image[i] = 1.0f - o.image[i];
+    }
+    buffer.add(o, a, 1.0f, n, false, 0.99f);
+    buffer.add(n, a, 2.0f, o, true, 0.99f);
+    const rl::ReplayBatch b = buffer.gather(torch::arange(2), torch::kCPU);
+    const double tolerance = storage == rl::ImageStorage::kUint8 ? 0.5 / 255 + 1e-6 : 1e-3;
+    for (int i = 0; i < 16; ++i) {
+      EXPECT_NEAR(b.image[0].flatten()[i].item<float>(), o.image[i], tolerance);
+      EXPECT_NEAR(b.next_image[1].flatten()[i].item<float>(), o.image[i], tolerance);
+    }
+    const std::string path = temp_path("replay.pt");
+    buffer.save(path);
+    rl::ReplayBuffer restored(spec, {rl::ActionKind::kContinuous, 2}, 10, storage);
+    restored.load(path);
+    EXPECT_EQ(restored.size(), 2);
+    EXPECT_EQ(restored.next_slot(), 2);
+    const rl::ReplayBatch c = restored.gather(torch::arange(2), torch::kCPU);
+    EXPECT_TRUE(torch::equal(b.image, c.image));
+    EXPECT_TRUE(torch::equal(b.next_image, c.next_image));
+    EXPECT_TRUE(torch::equal(b.action, c.action));
+    EXPECT_TRUE(torch::equal(b.bootstrap, c.bootstrap));
+    rl::ReplayBuffer wrong(spec, {rl::ActionKind::kContinuous, 2}, 11, storage);
+    EXPECT_THROW(wrong.load(path), std::runtime_error);
+    std::filesystem::remove(path);
+  }
+}
+
+// ---- networks -------------------------------------------------------------------
+
+TEST(Networks, PaperEncoderShapesForImageSizes) {
+  for (int size : {16, 32, 20}) {
+    rl::CnnEncoder enc(1, size, size, 9);
+    const torch::Tensor out = enc->forward(torch::rand({3, 1, size, size}));
+    EXPECT_EQ(out.sizes(), (std::vector<std::int64_t>{3, 9}));
+  }
+  // conv1 (1->32, 5x5), conv2 (32->64, 5x5), FC 64*4*4 -> 256, FC 256 -> 9 at 16x16.
+  rl::CnnEncoder enc(1, 16, 16, 9);
+  std::int64_t params = 0;
+  for (const auto& p : enc->parameters()) params += p.numel();
+  EXPECT_EQ(params, (32 * 25 + 32) + (64 * 32 * 25 + 64) + (1024 * 256 + 256) + (256 * 9 + 9));
+}
+
+TEST(Networks, QNetworkImageOnlyIsThePaperNetAndTakesImagePlusVector) {
+  rl::QNetwork paper(rl::ObservationSpec{1, 16, 16, 0}, 9, std::vector<int>{}, 256);
+  std::int64_t params = 0;
+  for (const auto& p : paper->parameters()) params += p.numel();
+  EXPECT_EQ(params, (32 * 25 + 32) + (64 * 32 * 25 + 64) + (1024 * 256 + 256) + (256 * 9 + 9));
+  rl::QNetwork both(rl::ObservationSpec{1, 16, 16, 5}, 9, std::vector<int>{64}, 16);
+  const torch::Tensor q = both->forward(torch::rand({2, 1, 16, 16}), torch::rand({2, 5}));
+  EXPECT_EQ(q.sizes(), (std::vector<std::int64_t>{2, 9}));
+}
+
+TEST(Networks, SharedEncoderGetsNoGradientFromTheActor) {
+  rl::ActorCritic nets(rl::ObservationSpec{1, 16, 16, 4}, 5, 5, std::vector<int>{32}, 16, 256, /*share_encoder=*/true);
+  const torch::Tensor image = torch::rand({4, 1, 16, 16}), vector = torch::rand({4, 4});
+  const torch::Tensor f = nets->critic_features(image, vector);
+  EXPECT_EQ(f.size(1), 16 + 4);
+  const torch::Tensor a = torch::tanh(nets->actor_head(nets->actor_features(image, vector, f)));
+  nets->q1(f.detach(), a).mean().backward();
+  for (const auto& p : nets->critic_encoder->parameters()) EXPECT_FALSE(p.grad().defined());
+  for (const auto& p : nets->actor->parameters()) EXPECT_TRUE(p.grad().defined());
+  // The critic loss does train the encoder.
+  (nets->q1(f, a.detach()) + nets->q2(f, a.detach())).mean().backward();
+  for (const auto& p : nets->critic_encoder->parameters()) EXPECT_TRUE(p.grad().defined());
+  // Not shared: the actor has its own encoder and parameters.
+  rl::ActorCritic separate(rl::ObservationSpec{1, 16, 16, 4}, 5, 5, std::vector<int>{32}, 16, 256, /*share_encoder=*/false);
+  EXPECT_GT(separate->actor_parameters().size(), separate->actor->parameters().size());
+}
+
+TEST(Networks, SoftUpdateIsPolyakAverage) {
+  rl::Mlp a(3, std::vector<int>{4}, 2), b(3, std::vector<int>{4}, 2);
+  rl::copy_parameters(*b, *a);
+  EXPECT_TRUE(torch::equal(a->parameters()[0], b->parameters()[0]));
+  rl::Mlp c(3, std::vector<int>{4}, 2);
+  const torch::Tensor before = b->parameters()[0].clone();
+  rl::soft_update(*b, *c, 0.25);
+  EXPECT_TRUE(torch::allclose(b->parameters()[0], 0.75 * before + 0.25 * c->parameters()[0]));
+}
+
+// ---- DQN masking and targets ------------------------------------------------------
+
+TEST(Dqn, ActsOnlyAmongValidActions) {
+  rl::DqnConfig c;
+  c.hidden_sizes = {16};
+  rl::Dqn dqn({0, 0, 0, 3}, 9, c, 7);
+  rl::Action a;
+  for (int trial = 0; trial < 200; ++trial) {
+    std::vector<std::uint8_t> mask(9, 0);
+    mask[trial % 9] = 1;
+    mask[(trial * 5 + 3) % 9] = 1;
+    const rl::Observation o = vector_obs({float(trial % 7), 0.5f, -1.0f}, mask);
+    for (bool explore : {true, false}) {
+      dqn.act(o, explore, a);
+      ASSERT_TRUE(a.discrete >= 0 && a.discrete < 9);
+      EXPECT_EQ(mask[a.discrete], 1) << "picked invalid action " << a.discrete;
+    }
+  }
+  // Greedy: the best valid action, even when an invalid one has a higher Q.
+  const rl::Observation o = vector_obs({1, 2, 3});
+  const std::vector<float> q = dqn.q_values(o);
+  const int best = static_cast<int>(std::max_element(q.begin(), q.end()) - q.begin());
+  std::vector<std::uint8_t> mask(9, 1);
+  mask[best] = 0;
+  dqn.act(vector_obs({1, 2, 3}, mask), false, a);
+  EXPECT_NE(a.discrete, best);
+  int second = -1;
+  for (int i = 0; i < 9; ++i)
+    if (i != best && (second < 0 || q[i] > q[second])) second = i;
+  EXPECT_EQ(a.discrete, second);
+  EXPECT_THROW(dqn.act(vector_obs({1, 2, 3}, std::vector<std::uint8_t>(9, 0)), false, a),
+               std::invalid_argument);
+}
+
+TEST(Dqn, TargetMaximisesOverNextValidActionsAndRespectsTermination) {
+  rl::DqnConfig c;
+  c.hidden_sizes = {16};
+  c.gamma = 0.9;
+  rl::Dqn dqn({0, 0, 0, 2}, 4, c, 3);
+  rl::Action a;
+  a.discrete = 1;
+  const rl::Observation s = vector_obs({0.1f, 0.2f});
+  const rl::Observation next = vector_obs({0.3f, -0.4f}, {0, 1, 0, 1});
+  dqn.store(s, a, 1.0f, next, /*terminated=*/false, /*truncated=*/true);  // truncated: bootstrap
+  dqn.store(s, a, 1.0f, next, /*terminated=*/true, false);               // terminal: no bootstrap
+  dqn.store(s, a, 1.0f, next, false, false, /*steps=*/3);                 // semi-MDP: gamma^3
+  dqn.store(s, a, 2.0f, vector_obs({0.3f, -0.4f}, {0, 0, 0, 0}), true, false);  // no valid next
+  const rl::ReplayBatch b = dqn.replay().gather(torch::arange(4), torch::kCPU);
+  const torch::Tensor y = dqn.td_target(b);
+  torch::Tensor q_next;
+  {
+    torch::NoGradGuard g;
+    q_next = dqn.target_network()->forward({}, b.next_vector[0].unsqueeze(0))[0];
+  }
+  const float best_valid = std::max(q_next[1].item<float>(), q_next[3].item<float>());
+  EXPECT_NEAR(y[0].item<float>(), 1.0f + 0.9f * best_valid, 1e-5);
+  EXPECT_EQ(y[1].item<float>(), 1.0f);
+  EXPECT_NEAR(y[2].item<float>(), 1.0f + std::pow(0.9f, 3) * best_valid, 1e-5);
+  EXPECT_EQ(y[3].item<float>(), 2.0f);
+  // The masked max differs from the unmasked one when an invalid action is best.
+  const float best_any = q_next.max().item<float>();
+  if (best_any != best_valid) EXPECT_GT(std::abs(y[0].item<float>() - (1.0f + 0.9f * best_any)), 1e-6);
+}
+
+TEST(Dqn, EpsilonScheduleIsLinearThenFlat) {
+  rl::DqnConfig c;
+  c.hidden_sizes = {8};
+  c.epsilon_start = 1.0;
+  c.epsilon_end = 0.1;
+  c.epsilon_decay = 10;
+  rl::Dqn dqn({0, 0, 0, 1}, 2, c, 1);
+  rl::Action a;
+  a.discrete = 0;
+  EXPECT_DOUBLE_EQ(dqn.epsilon(), 1.0);
+  for (int i = 0; i < 5; ++i) dqn.store(vector_obs({0}), a, 0, vector_obs({0}), false, false);
+  EXPECT_NEAR(dqn.epsilon(), 0.55, 1e-12);
+  for (int i = 0; i < 10; ++i) dqn.store(vector_obs({0}), a, 0, vector_obs({0}), false, false);
+  EXPECT_NEAR(dqn.epsilon(), 0.1, 1e-12);
+}
+
+TEST(Td3, ExplorationNoiseDecaysPerEpisode) {
+  rl::Td3Config c;
+  c.hidden_sizes = {8};
+  c.exploration_noise_start = 0.12;
+  c.exploration_noise_end = 0.02;
+  c.exploration_noise_decay = 4;
+  c.exploration_noise_unit = "episodes";
+  rl::Td3 td3({0, 0, 0, 1}, 1, c, 1);
+  rl::Action a;
+  a.continuous = {0};
+  EXPECT_DOUBLE_EQ(td3.exploration_noise(), 0.12);
+  td3.store(vector_obs({0}), a, 0, vector_obs({0}), false, false);
+  EXPECT_DOUBLE_EQ(td3.exploration_noise(), 0.12);  // not an episode end
+  td3.store(vector_obs({0}), a, 0, vector_obs({0}), false, true);
+  td3.store(vector_obs({0}), a, 0, vector_obs({0}), true, false);
+  EXPECT_NEAR(td3.exploration_noise(), 0.07, 1e-12);
+  for (int i = 0; i < 3; ++i) td3.store(vector_obs({0}), a, 0, vector_obs({0}), true, false);
+  EXPECT_NEAR(td3.exploration_noise(), 0.02, 1e-12);
+}
+
+// ---- hyperparameter files -----------------------------------------------------------
+
+TEST(Config, EveryPresetLoadsAndUnknownFieldsAreRejected) {
+  for (const char* name : {"pendulum_td3", "pendulum_sac", "cartpole_dqn", "robot_td3_paper",
+                           "robot_sac_paper", "robot_dqn_paper"}) {
+    const std::string path = rl::rl_config_dir() + "/" + name + ".yaml";
+    const YAML::Node node = rl::load_yaml_file(path);
+    const std::string algo = std::string(name).find("td3") != std::string::npos   ? "td3"
+                             : std::string(name).find("sac") != std::string::npos ? "sac"
+                                                                                  : "dqn";
+    if (algo == "td3") EXPECT_NO_THROW(rl::Td3Config::from_yaml(node, path)) << path;
+    if (algo == "sac") EXPECT_NO_THROW(rl::SacConfig::from_yaml(node, path)) << path;
+    if (algo == "dqn") EXPECT_NO_THROW(rl::DqnConfig::from_yaml(node, path)) << path;
+  }
+  const rl::Td3Config paper =
+      rl::Td3Config::from_yaml(rl::load_yaml_file(rl::rl_config_dir() + "/robot_td3_paper.yaml"), "x");
+  EXPECT_DOUBLE_EQ(paper.actor_learning_rate, 5e-5);
+  EXPECT_DOUBLE_EQ(paper.tau, 0.05);
+  EXPECT_EQ(paper.policy_delay, 3);
+  try {
+    rl::Td3Config::from_yaml(YAML::Load("gama: 0.9"), "my.yaml");
+    FAIL() << "misspelt field accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("gama"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("my.yaml"), std::string::npos);
+  }
+  EXPECT_THROW(rl::DqnConfig::from_yaml(YAML::Load("loss: l1"), "x"), std::invalid_argument);
+  EXPECT_THROW(rl::SacConfig::from_yaml(YAML::Load("batch_size: abc"), "x"), std::invalid_argument);
+  EXPECT_THROW(rl::make_learner("dqn", {0, 0, 0, 3}, {rl::ActionKind::kContinuous, 1}, YAML::Node(),
+                                "x", 1),
+               std::invalid_argument);
+}
