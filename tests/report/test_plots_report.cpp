@@ -1,0 +1,182 @@
+// Training curves and the report, from tiny run directories written here.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "report/plots.hpp"
+#include "report/process.hpp"
+#include "report/report.hpp"
+
+namespace fs = std::filesystem;
+
+namespace comorph::report {
+namespace {
+
+bool have_gnuplot() { return !find_executable("gnuplot").empty(); }
+
+// A PNG file: exists, non-empty, starts with the PNG signature.
+void expect_png(const fs::path& path) {
+  ASSERT_TRUE(fs::is_regular_file(path)) << path;
+  EXPECT_GT(fs::file_size(path), 1000u) << path;
+  std::ifstream in(path, std::ios::binary);
+  char sig[8] = {};
+  in.read(sig, 8);
+  EXPECT_EQ(std::string(sig + 1, 3), "PNG") << path;
+}
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Episodes whose success probability grows with training, like a learning run.
+std::vector<EpisodeRecord> fake_episodes(int n, int modules, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  const double heights[] = {0.04, 0.06, 0.08};
+  std::vector<EpisodeRecord> out;
+  for (int i = 0; i < n; ++i) {
+    EpisodeRecord r;
+    r.episode = i;
+    r.seed = seed * 1000 + i;
+    r.scenario = "default";
+    r.stair_height_m = heights[rng() % 3];
+    r.obstacles = 6;
+    r.success = u(rng) < 0.1 + 0.8 * i / n;
+    r.termination = r.success ? "success" : (u(rng) < 0.5 ? "collision" : "timeout");
+    r.time_s = r.success ? 35 + 20 * u(rng) : 112;
+    r.energy_J = 27.0 * modules * r.time_s;
+    r.distance_fraction = r.success ? 1.0 : u(rng);
+    r.return_R1 = 200 * r.distance_fraction + (r.success ? 100 : -10) + 20 * u(rng);
+    r.configurations = modules == 10 ? std::vector<int>{2 + 2 * static_cast<int>(rng() % 3), 2}
+                                     : std::vector<int>{modules};
+    r.modules_total = r.configurations.front();
+    out.push_back(r);
+  }
+  return out;
+}
+
+struct TinyRuns {
+  fs::path root;
+  fs::path hier, fixed4;
+  Metrics hier_eval, fixed4_eval, hier_eval7;
+
+  TinyRuns() {
+    root = fs::temp_directory_path() / fmt::format("comorph-report-test-{}", ::getpid());
+    fs::remove_all(root);
+    hier = root / "hier-td3";
+    fixed4 = root / "fixed4";
+    fs::create_directories(hier);
+    fs::create_directories(fixed4);
+    std::ofstream(hier / "run.yaml") << "kind: hierarchical\nmodules: 10\nalgo: td3\nscenario: default\n";
+    std::ofstream(fixed4 / "run.yaml") << "name: fixed-4\nkind: fixed\nmodules: 4\nalgo: td3\n";
+    write_episodes_csv((hier / "episodes.csv").string(), fake_episodes(300, 10, 1));
+    write_episodes_csv((fixed4 / "episodes.csv").string(), fake_episodes(250, 4, 2));
+    hier_eval = summarize(fake_episodes(60, 10, 3));
+    hier_eval7 = summarize(fake_episodes(30, 10, 4));
+    fixed4_eval = summarize(fake_episodes(60, 4, 5));
+    write_metrics_json((hier / "eval-default.json").string(), hier_eval);
+    write_metrics_json((hier / "eval-obstacles7.json").string(), hier_eval7);
+    write_metrics_json((fixed4 / "eval-default.json").string(), fixed4_eval);
+  }
+  ~TinyRuns() { fs::remove_all(root); }
+};
+
+TEST(Plots, MovingAverageIsTrailing) {
+  const auto avg = moving_average({2, 4, 6, 8}, 2);
+  ASSERT_EQ(avg.size(), 4u);
+  EXPECT_DOUBLE_EQ(avg[0], 2);  // only one value so far
+  EXPECT_DOUBLE_EQ(avg[1], 3);
+  EXPECT_DOUBLE_EQ(avg[2], 5);
+  EXPECT_DOUBLE_EQ(avg[3], 7);
+  EXPECT_THROW(moving_average({1}, 0), std::invalid_argument);
+}
+
+TEST(Plots, TrainingCurvesPng) {
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed";
+  TinyRuns runs;
+  const fs::path png = runs.root / "curves.png";
+  plot_training_curves({{"a", fake_episodes(200, 4, 7)}, {"b's run", fake_episodes(150, 6, 8)}}, png.string());
+  expect_png(png);
+  EXPECT_TRUE(fs::is_regular_file(runs.root / "curves.gp"));
+  EXPECT_TRUE(fs::is_regular_file(runs.root / "curves-1.dat"));
+  EXPECT_THROW(plot_training_curves({{"empty", {}}}, (runs.root / "e.png").string()), std::invalid_argument);
+}
+
+TEST(Report, TablesHoldThePapersNumbersAndOurs) {
+  TinyRuns runs;
+  ReportOptions options;
+  options.out_dir = (runs.root / "out").string();
+  options.curve_window = 20;
+  options.require_plots = have_gnuplot();
+  const ReportResult result = write_report({runs.hier.string(), runs.fixed4.string()}, options);
+  const std::string md = slurp(result.markdown_path);
+  const std::string html = slurp(result.html_path);
+
+  // Table I, hierarchical column: ours beside the paper's 43.1 s, 3090 J, 89.3 %, F 1.136.
+  EXPECT_NE(md.find(fmt::format("| {:.1f} / 43.1 |", runs.hier_eval.time_s)), std::string::npos) << md;
+  EXPECT_NE(md.find(fmt::format("| {:.0f} / 3090 |", runs.hier_eval.energy_J)), std::string::npos) << md;
+  EXPECT_NE(md.find(fmt::format("| {:.1f} / 89.3 |", 100 * runs.hier_eval.success_rate.at("avg"))),
+            std::string::npos) << md;
+  EXPECT_NE(md.find(fmt::format("| {:.3f} / 1.136 |", runs.hier_eval.F)), std::string::npos) << md;
+  // Fixed 4: ours beside 42.7 s and 78.5 % at 0.04 m; fixed 2 has no run.
+  EXPECT_NE(md.find(fmt::format("| {:.1f} / 42.7 |", runs.fixed4_eval.time_s)), std::string::npos) << md;
+  EXPECT_NE(md.find(fmt::format("| {:.1f} / 78.5 |", 100 * runs.fixed4_eval.success_rate.at("0.04"))),
+            std::string::npos) << md;
+  EXPECT_NE(md.find("| — / 56.2 |"), std::string::npos) << md;
+  // Table II: 7 obstacles from eval-obstacles7.json; SAC has no run.
+  EXPECT_NE(md.find(fmt::format("| {:.1f} / 50.2 |", runs.hier_eval7.time_s)), std::string::npos) << md;
+  EXPECT_NE(md.find("| — / 57.6 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("Table I:"), std::string::npos);
+  EXPECT_NE(md.find("Table II:"), std::string::npos);
+  // Configurations per stair height, with the paper's choice beside.
+  EXPECT_NE(md.find("| default | 0.06 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 4->2 |"), std::string::npos) << md;
+  EXPECT_NE(html.find("<table>"), std::string::npos);
+  EXPECT_NE(html.find(fmt::format("<td>{:.1f} / 43.1</td>", runs.hier_eval.time_s)), std::string::npos);
+
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed: no training curves to check";
+  ASSERT_EQ(result.images.size(), 1u);
+  expect_png(result.images[0]);
+  EXPECT_NE(md.find("![Score per episode"), std::string::npos);
+  EXPECT_NE(html.find("<img src=\"training-curves.png\""), std::string::npos);
+}
+
+TEST(Report, MissingFilesAreNamed) {
+  TinyRuns runs;
+  fs::remove(runs.fixed4 / "episodes.csv");
+  fs::remove(runs.fixed4 / "eval-default.json");
+  ReportOptions options;
+  options.out_dir = (runs.root / "out").string();
+  try {
+    write_report({runs.hier.string(), runs.fixed4.string()}, options);
+    FAIL() << "wrote a report from an incomplete run directory";
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find((runs.fixed4 / "episodes.csv").string()), std::string::npos) << msg;
+    EXPECT_NE(msg.find("eval-<scenario>.json"), std::string::npos) << msg;
+  }
+  fs::remove(runs.hier / "run.yaml");
+  EXPECT_THROW(write_report({runs.hier.string()}, options), std::runtime_error);
+}
+
+TEST(Report, BadRunYamlIsNamed) {
+  TinyRuns runs;
+  std::ofstream(runs.fixed4 / "run.yaml") << "kind: fixed\nmodules: 4\nalgo: ppo\n";
+  try {
+    load_run_dir(runs.fixed4.string());
+    FAIL() << "accepted algo ppo";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("run.yaml: algo 'ppo'"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace comorph::report
