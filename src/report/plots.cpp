@@ -86,7 +86,7 @@ void plot_training_curves(const std::vector<CurveSeries>& series, const std::str
          << fmt::format("set terminal {} size {},{}\n", options.terminal, options.width_px, options.height_px)
          << "set output " << quoted(png_path) << "\n"
          << "set datafile commentschars '#'\n"
-         << "set grid\nset key left top\n"
+         << "set grid\nset key left top opaque\n"
          << "set multiplot layout 2,1 title " << quoted(options.title) << "\n"
          << "set xlabel 'episode'\n"
          << "set ylabel 'score (return of R1)'\n"

@@ -20,6 +20,9 @@ namespace {
 // A number with `decimals` digits after the point, or "n/a" when absent.
 std::string num(double x, int decimals) { return std::isfinite(x) ? fmt::format("{:.{}f}", x, decimals) : "n/a"; }
 
+// The paper's numbers as the paper prints them (shortest exact text: 2.28, 3090).
+std::string paper_num(double x) { return std::isfinite(x) ? fmt::format("{}", x) : "n/a"; }
+
 std::string percent(double fraction) { return std::isfinite(fraction) ? num(100.0 * fraction, 1) : "n/a"; }
 
 double lookup(const std::map<std::string, double>& m, const std::string& key) {
@@ -140,15 +143,15 @@ ReportBlock comparison_table(const PaperTable& paper, const std::vector<RunDir>&
     rows.push_back(std::move(r));
   };
   row("Time (s)", [](const Metrics& m) { return num(m.time_s, 1); },
-      [](const PaperColumn& p) { return num(p.time_s, 1); });
+      [](const PaperColumn& p) { return paper_num(p.time_s); });
   row("Battery (J)", [](const Metrics& m) { return num(m.energy_J, 0); },
-      [](const PaperColumn& p) { return num(p.energy_J, 0); });
+      [](const PaperColumn& p) { return paper_num(p.energy_J); });
   for (const std::string key : {"0.04", "0.06", "0.08", "avg"}) {
     const std::string name = key == "avg" ? "Success avg (%)" : fmt::format("Success {} m (%)", key);
     row(name, [key](const Metrics& m) { return percent(lookup(m.success_rate, key)); },
-        [key](const PaperColumn& p) { return num(lookup(p.success_percent, key), 1); });
+        [key](const PaperColumn& p) { return paper_num(lookup(p.success_percent, key)); });
   }
-  row("F(H)", [](const Metrics& m) { return num(m.F, 3); }, [](const PaperColumn& p) { return num(p.F, 3); });
+  row("F(H)", [](const Metrics& m) { return num(m.F, 3); }, [](const PaperColumn& p) { return paper_num(p.F); });
   row("Episodes", [](const Metrics& m) { return std::to_string(m.episodes); },
       [](const PaperColumn&) { return std::string("n/a"); });
   return table(std::move(header), std::move(rows));
