@@ -59,7 +59,7 @@ class TrainedClassifier : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     cp::SceneClassifier::set_threads(1);
-    train_ = std::make_unique<cp::Dataset>(synthetic(900, 11));
+    train_ = std::make_unique<cp::Dataset>(synthetic(600, 11));
     held_out_ = std::make_unique<cp::Dataset>(synthetic(300, 12));
     result_ = std::make_unique<cp::TrainResult>(
         cp::train_classifier(*train_, small_net(), quick_training(), held_out_.get()));
@@ -80,7 +80,7 @@ std::unique_ptr<cp::TrainResult> TrainedClassifier::result_;
 TEST_F(TrainedClassifier, LearnsTheSyntheticDepthTask) {
   const cp::TrainResult& r = *result_;
   ASSERT_EQ(r.epochs.size(), 6u);
-  EXPECT_EQ(r.train_count, 900u);
+  EXPECT_EQ(r.train_count, 600u);
   EXPECT_EQ(r.eval_count, 300u);
   EXPECT_LT(r.epochs.back().train_loss, r.epochs.front().train_loss);
   EXPECT_GT(r.eval.accuracy, 0.90);
@@ -104,7 +104,7 @@ TEST(Classifier, ShuffledLabelsStayNearChance) {
   // accuracy must stay near 1/3 (a leak between images and labels, or an
   // evaluation bug, would show up here).
   cp::SceneClassifier::set_threads(1);
-  cp::Dataset train = synthetic(900, 11);
+  cp::Dataset train = synthetic(600, 11);
   std::mt19937 rng(5);
   std::shuffle(train.labels.begin(), train.labels.end(), rng);
   const cp::Dataset held_out = synthetic(300, 12);
