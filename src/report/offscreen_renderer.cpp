@@ -60,6 +60,21 @@ OffscreenRenderer::OffscreenRenderer(const mjModel* model, int width, int height
   EGLContext context = eglCreateContext(display, choose_config(display), EGL_NO_CONTEXT, nullptr);
   if (context == EGL_NO_CONTEXT) throw std::runtime_error(egl_error("eglCreateContext"));
   egl_context_ = context;
+  mjv_defaultScene(&scene_);
+  mjr_defaultContext(&context_);
+  mjv_defaultOption(&option_);
+  mjv_defaultCamera(&camera_);
+  try {
+    init_mujoco(model, width, height);
+  } catch (...) {
+    mjv_freeScene(&scene_);  // safe on a default scene
+    eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglDestroyContext(display, context);
+    throw;
+  }
+}
+
+void OffscreenRenderer::init_mujoco(const mjModel* model, int width, int height) {
   make_current();
   if (const auto* r = glGetString(GL_RENDERER)) gl_renderer_ = reinterpret_cast<const char*>(r);
 
@@ -71,16 +86,14 @@ OffscreenRenderer::OffscreenRenderer(const mjModel* model, int width, int height
     sized->vis.global.offwidth = std::max(width, model->vis.global.offwidth);
     sized->vis.global.offheight = std::max(height, model->vis.global.offheight);
   }
-  mjv_defaultScene(&scene_);
-  mjr_defaultContext(&context_);
-  mjv_defaultOption(&option_);
-  mjv_defaultCamera(&camera_);
   mjv_makeScene(model, &scene_, 2000);
   mjr_makeContext(sized ? sized : model, &context_, mjFONTSCALE_100);
   if (sized) mj_deleteModel(sized);
   mjr_setBuffer(mjFB_OFFSCREEN, &context_);
-  if (context_.currentBuffer != mjFB_OFFSCREEN)
+  if (context_.currentBuffer != mjFB_OFFSCREEN) {
+    mjr_freeContext(&context_);
     throw std::runtime_error("MuJoCo could not select its offscreen framebuffer");
+  }
 }
 
 OffscreenRenderer::~OffscreenRenderer() {

@@ -60,6 +60,7 @@ class OffscreenRenderer {
   mjvOption option_;
   mjvCamera camera_;
   void make_current() const;
+  void init_mujoco(const mjModel* model, int width, int height);  // GL context current -> MuJoCo contexts
 };
 
 }  // namespace comorph::report
