@@ -110,6 +110,26 @@ TEST(Plots, TrainingCurvesPng) {
   EXPECT_THROW(plot_training_curves({{"empty", {}}}, (runs.root / "e.png").string()), std::invalid_argument);
 }
 
+// With gnuplot off PATH, plotting (and so the report) stops with a message
+// naming the tool and its Debian package.
+TEST(Plots, MissingGnuplotIsNamed) {
+  TinyRuns runs;
+  const std::string saved = std::getenv("PATH") ? std::getenv("PATH") : "";
+  setenv("PATH", (runs.root / "empty-bin").c_str(), 1);
+  std::string msg;
+  try {
+    plot_training_curves({{"a", fake_episodes(20, 4, 7)}}, (runs.root / "c.png").string());
+  } catch (const std::runtime_error& e) {
+    msg = e.what();
+  }
+  ReportOptions options;
+  options.out_dir = (runs.root / "out").string();
+  EXPECT_THROW(write_report({runs.hier.string()}, options), std::runtime_error);
+  setenv("PATH", saved.c_str(), 1);
+  EXPECT_NE(msg.find("'gnuplot' is not installed"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("gnuplot-nox"), std::string::npos) << msg;
+}
+
 TEST(Report, TablesHoldThePapersNumbersAndOurs) {
   TinyRuns runs;
   ReportOptions options;

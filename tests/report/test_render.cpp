@@ -161,6 +161,19 @@ TEST(Render, KeyframesAreEvenlySpaced) {
   EXPECT_EQ(evenly_spaced(0, 3), std::vector<int>{});
 }
 
+TEST(Render, MissingFfmpegIsNamed) {
+  const std::string saved = std::getenv("PATH") ? std::getenv("PATH") : "";
+  setenv("PATH", "/nonexistent-comorph-bin", 1);
+  std::string msg;
+  try {
+    VideoWriter video("/tmp/never.mp4", 16, 16);
+  } catch (const std::runtime_error& e) {
+    msg = e.what();
+  }
+  setenv("PATH", saved.c_str(), 1);
+  EXPECT_NE(msg.find("'ffmpeg' is not installed"), std::string::npos) << msg;
+}
+
 TEST(Render, MissingToolIsNamed) {
   try {
     require_executable("comorph-no-such-tool", "some-package");
