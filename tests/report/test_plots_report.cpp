@@ -1,6 +1,7 @@
 // Training curves and the report, from tiny run directories written here.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -11,6 +12,7 @@
 #include "report/plots.hpp"
 #include "report/process.hpp"
 #include "report/report.hpp"
+#include "report/video.hpp"
 
 namespace fs = std::filesystem;
 
@@ -23,6 +25,13 @@ bool have_gnuplot() { return !find_executable("gnuplot").empty(); }
 void expect_png(const fs::path& path) {
   ASSERT_TRUE(fs::is_regular_file(path)) << path;
   EXPECT_GT(fs::file_size(path), 1000u) << path;
+  std::ifstream in(path, std::ios::binary);
+  char sig[8] = {};
+  in.read(sig, 8);
+  EXPECT_EQ(std::string(sig + 1, 3), "PNG") << path;
+}
+
+void expect_png_header(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   char sig[8] = {};
   in.read(sig, 8);
@@ -167,6 +176,25 @@ TEST(Report, TablesHoldThePapersNumbersAndOurs) {
   expect_png(result.images[0]);
   EXPECT_NE(md.find("![Score per episode"), std::string::npos);
   EXPECT_NE(html.find("<img src=\"training-curves.png\""), std::string::npos);
+}
+
+// A keyframe strip left by `comorph render` in a run directory is copied and shown.
+TEST(Report, IncludesKeyframeStripsOfARun) {
+  TinyRuns runs;
+  Image strip;
+  strip.width = 40;
+  strip.height = 10;
+  strip.rgb.assign(40 * 10 * 3, 200);
+  write_png(strip, (runs.hier / "render-7.png").string());
+  expect_png_header(runs.hier / "render-7.png");
+  ReportOptions options;
+  options.out_dir = (runs.root / "out").string();
+  options.require_plots = false;
+  const ReportResult result = write_report({runs.hier.string()}, options);
+  const fs::path copied = runs.root / "out" / "hier-td3-render-7.png";
+  EXPECT_TRUE(fs::is_regular_file(copied));
+  EXPECT_NE(std::find(result.images.begin(), result.images.end(), copied.string()), result.images.end());
+  EXPECT_NE(slurp(result.markdown_path).find("](hier-td3-render-7.png)"), std::string::npos);
 }
 
 TEST(Report, MissingFilesAreNamed) {
