@@ -138,6 +138,9 @@ PhysicsStepInfo World::step_control(const double* ctrl) {
         info.stair_contact = true;
     }
   }
+  // mj_step leaves xpos/xmat at the pre-integration state: refresh the kinematics so
+  // that sensors and checks see the current qpos (cheap: no dynamics).
+  mj_kinematics(model_, data_);
   if (info.instability == Instability::none) {
     for (int i = 0; i < model_->nq; ++i)
       if (!std::isfinite(data_->qpos[i])) info.instability = Instability::nan_state;
@@ -253,12 +256,24 @@ void World::render_depth_at(const double pos[3], double yaw, double pitch, float
   }
 }
 
-void World::render_depth(float* out) const {
+void World::camera_pos(double pos[3]) const {
   const double* x = module_pos(0);
   const double* R = module_mat(0);
   const double off[3] = {0.5 * robot_.module_length, 0, robot_.camera_height - robot_.wheel_radius};
-  double pos[3];
   for (int a = 0; a < 3; ++a) pos[a] = x[a] + R[3 * a] * off[0] + R[3 * a + 1] * off[1] + R[3 * a + 2] * off[2];
+}
+
+void World::depth_ray(int pixel, double pnt[3], double dir[3]) const {
+  camera_pos(pnt);
+  const double* R = module_mat(0);
+  const double* d = &ray_dirs_[3 * std::size_t(pixel)];
+  for (int a = 0; a < 3; ++a) dir[a] = R[3 * a] * d[0] + R[3 * a + 1] * d[1] + R[3 * a + 2] * d[2];
+}
+
+void World::render_depth(float* out) const {
+  const double* R = module_mat(0);
+  double pos[3];
+  camera_pos(pos);
   const int n = robot_.depth_width * robot_.depth_height;
   const double range = robot_.depth_max_range;
   for (int i = 0; i < n; ++i) {

@@ -57,6 +57,8 @@ class World {
   // Left and right distance per module, normalised by distance_range, in [0, 1]:
   // out[2k] = left of module k, out[2k+1] = right (1 = nothing within range).
   void read_distances(float* out) const;
+  // The world ray (origin, unit direction) of depth pixel `pixel` (row-major) at the current pose.
+  void depth_ray(int pixel, double pnt[3], double dir[3]) const;
   // Nearest scene hit along a ray (m), or -1 (same geoms as the sensors).
   double cast_ray(const double pnt[3], const double dir[3], double max_dist) const;
 
@@ -90,6 +92,7 @@ class World {
   PerChain& chain(int modules);
   void bind(int modules);
   double ray_scene(const double pnt[3], const double dir[3], double max_dist) const;
+  void camera_pos(double pos[3]) const;
 
   RobotParams robot_;
   SceneParams scene_;

@@ -17,7 +17,7 @@ struct TaskParams {
   int max_steps = 3500;        // control steps before truncation (~112 s at 32 ms)
   double overturn_up_z = 0.2;  // a module whose up axis has a world z below this is overturned (~78 deg tilt)
   double start_zone_length = 3.0;  // m behind the start face the robot may back up before leaving the area
-  double stair_goal_offset = 0.6;  // m past the top edge: the goal while the stairs are not yet climbed
+  double stair_goal_offset = 0.3;  // m: goal while the stairs are not climbed = top edge + this + chain length
 };
 
 struct EnvConfig {

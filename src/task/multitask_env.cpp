@@ -50,7 +50,8 @@ void MultiTaskEnv::goal(double& x, double& y) const {
     x = s.target_x;
     y = s.target_y;
   } else {
-    x = s.platform_x + config_.task.stair_goal_offset;
+    // Far enough that the whole chain is on the top when module 1 reaches it.
+    x = s.platform_x + config_.task.stair_goal_offset + world_.modules() * config_.robot.module_length;
     y = 0.0;
   }
 }

@@ -91,9 +91,14 @@ void ScriptedPilot::act(const MultiTaskEnv& env, float a[control::kActionSize],
       gy = env.world().layout().target_y;
     }
   }
+  const bool climbing = !env.stairs_climbed();
+  if (climbing) {  // straight up the middle of the stairs
+    gx = head[0] + 1.0;
+    gy = 0.0;
+  }
   const double error = wrap(std::atan2(gy - head[1], gx - head[0]) - heading);
   a[1] = float(std::clamp(p_.heading_gain * error, -1.0, 1.0));
-  if (mode == control::MotionMode::stair) {
+  if (climbing) {
     a[0] = p_.gait.speed;
     a[2] = p_.gait.amp_front;
     a[3] = p_.gait.phase;

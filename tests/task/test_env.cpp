@@ -1,0 +1,225 @@
+// MultiTaskEnv: determinism, observation layout, events, termination reasons, reconfiguration.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "task/multitask_env.hpp"
+#include "task/scripted_pilot.hpp"
+
+using namespace comorph;
+using task::Termination;
+
+namespace {
+
+// Deterministic pseudo-random actions in [-1, 1].
+struct Lcg {
+  std::uint64_t s = 12345;
+  float next() {
+    s = s * 6364136223846793005ull + 1442695040888963407ull;
+    return float(double(s >> 11) / 9007199254740992.0 * 2.0 - 1.0);
+  }
+};
+
+task::EpisodeSpec spec(std::uint64_t seed, int modules, double h = 0, int k = -1) {
+  task::EpisodeSpec s;
+  s.seed = seed;
+  s.modules = modules;
+  s.stair_height = h;
+  s.obstacles = k;
+  return s;
+}
+
+}  // namespace
+
+TEST(Env, SameSeedAndActionsGiveTheSameTrajectory) {
+  const task::EnvConfig c;
+  task::MultiTaskEnv a(c), b(c);
+  a.reset(spec(5, 6));
+  b.reset(spec(5, 6));
+  Lcg rng;
+  const int pixels = a.depth_width() * a.depth_height();
+  for (int t = 0; t < 150 && !a.done(); ++t) {
+    float action[5];
+    for (float& x : action) x = rng.next();
+    const auto mode = t % 50 < 25 ? control::MotionMode::stair : control::MotionMode::flat;
+    const double ra = a.step(action, mode).reward, rb = b.step(action, mode).reward;
+    ASSERT_EQ(ra, rb) << t;
+    for (int i = 0; i < task::obs::kStateSize; ++i) ASSERT_EQ(a.state()[i], b.state()[i]) << t << " " << i;
+    for (int i = 0; i < pixels; ++i) ASSERT_EQ(a.depth()[i], b.depth()[i]) << t;
+    ASSERT_EQ(a.done(), b.done());
+  }
+  // Reusing an env (same cached models) reproduces the same trajectory too.
+  a.reset(spec(5, 6));
+  task::MultiTaskEnv fresh(c);
+  fresh.reset(spec(5, 6));
+  Lcg rng2;
+  for (int t = 0; t < 60; ++t) {
+    float action[5];
+    for (float& x : action) x = rng2.next();
+    a.step(action, control::MotionMode::stair);
+    fresh.step(action, control::MotionMode::stair);
+    ASSERT_EQ(a.world().data()->qpos[0], fresh.world().data()->qpos[0]) << t;
+  }
+}
+
+TEST(Env, ObservationLayout) {
+  task::EnvConfig c;
+  task::MultiTaskEnv env(c);
+  env.reset(spec(2, 4));
+  const float* s = env.state();
+  EXPECT_FLOAT_EQ(s[task::obs::kBattery], 1.0f);
+  EXPECT_NEAR(s[task::obs::kPosition], env.world().module_pos(0)[0], 1e-6);
+  EXPECT_NEAR(s[task::obs::kPosition + 2], c.robot.wheel_radius, 1e-3);
+  for (int k = 0; k < 10; ++k) EXPECT_EQ(s[task::obs::kModuleMask + k], k < 4 ? 1.0f : 0.0f);
+  for (int k = 4; k < 10; ++k) EXPECT_EQ(s[task::obs::kDistances + 2 * k], 0.0f);
+  EXPECT_GT(s[task::obs::kGoal], 0.9f);  // facing the stairs goal
+  EXPECT_EQ(s[task::obs::kMode], float(int(control::MotionMode::stair)));
+  EXPECT_EQ(env.scene_label(), sim::kLabelStairs);
+  const float a[5] = {1.0f, 0.2f, -1.0f, 0.0f, -1.0f};
+  for (int t = 0; t < 30; ++t) env.step(a, control::MotionMode::flat);
+  s = env.state();
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(s[task::obs::kPrevAction + i], a[i]);
+  EXPECT_EQ(s[task::obs::kPrevReward], float(env.last().reward));
+  EXPECT_GT(s[task::obs::kVelocity], 0.05f);   // driving towards +x
+  EXPECT_LT(s[task::obs::kBattery], 1.0f);
+  EXPECT_EQ(s[task::obs::kMode], float(int(control::MotionMode::flat)));
+  EXPECT_GT(env.last().reward, 0.0);  // progress towards the goal pays
+  for (int i = 0; i < env.depth_width() * env.depth_height(); ++i) {
+    EXPECT_GE(env.depth()[i], 0.01f);
+    EXPECT_LE(env.depth()[i], 1.0f);
+  }
+}
+
+TEST(Env, ScriptedRunClimbsReachesTheTargetAndReportsEvents) {
+  const task::EnvConfig c;
+  task::MultiTaskEnv env(c);
+  env.reset(spec(1, 4));
+  task::ScriptedPilot pilot;
+  pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};
+  pilot.plan(env);
+  std::vector<int> labels{env.scene_label()};
+  int climbed_events = 0;
+  double energy = 0;
+  float a[5];
+  control::MotionMode mode;
+  while (!env.done()) {
+    pilot.act(env, a, mode);
+    const task::StepResult& r = env.step(a, mode);
+    energy += r.energy_J;
+    climbed_events += r.stairs_climbed_now;
+    if (r.scene_label != labels.back()) labels.push_back(r.scene_label);
+  }
+  EXPECT_EQ(env.last().reason, Termination::success);
+  EXPECT_TRUE(env.last().terminated);
+  EXPECT_EQ(climbed_events, 1);
+  EXPECT_GT(env.stairs_climbed_step(), 0);
+  EXPECT_GT(env.stairs_energy(), 0.0);
+  EXPECT_LT(env.stairs_energy(), energy);
+  EXPECT_EQ(labels, (std::vector<int>{0, 1, 2}));
+  const task::Metrics m = env.metrics();
+  EXPECT_NEAR(m.energy_J, energy, 1e-6);
+  EXPECT_NEAR(m.E, energy / (4 * c.robot.battery_capacity), 1e-12);
+  EXPECT_GT(m.D, 0.9);
+  EXPECT_NEAR(m.T, m.steps / 3500.0, 1e-12);
+  EXPECT_NEAR(m.F, -m.T - m.E + m.D, 1e-12);
+  // Calibration: a competent run draws about 27 W per module.
+  const double watts = m.energy_J / m.time_s / 4;
+  EXPECT_GT(watts, 22.0);
+  EXPECT_LT(watts, 32.0);
+  float x[5] = {};
+  EXPECT_THROW(env.step(x), std::logic_error);
+}
+
+TEST(Env, FailureStatesEndTheEpisodeWithTheirReason) {
+  const task::EnvConfig c;
+  task::MultiTaskEnv env(c);
+  const float forward[5] = {1.0f, 0.0f, -1.0f, 0.0f, -1.0f};
+
+  // Leaving the stair lane sideways.
+  env.reset(spec(3, 3));
+  mjData* d = env.mutable_world().mutable_data();
+  d->qpos[1] = 1.2;
+  mj_forward(env.world().model(), d);
+  const task::StepResult& left = env.step(forward, control::MotionMode::flat);
+  EXPECT_TRUE(left.terminated);
+  EXPECT_EQ(left.reason, Termination::left_area);
+  EXPECT_LT(left.reward, -5.0);  // r_u
+
+  // Physics blow-up.
+  env.reset(spec(3, 3));
+  env.mutable_world().mutable_data()->qvel[2] = std::nan("");
+  EXPECT_EQ(env.step(forward, control::MotionMode::flat).reason, Termination::physics_unstable);
+
+  // Driving into an obstacle on the flat area.
+  env.reset(spec(3, 3, 0.04, 6));
+  const sim::SceneLayout& s = env.world().layout();
+  const sim::Box& o = s.obstacles[0];
+  d = env.mutable_world().mutable_data();
+  d->qpos[0] = o.x - o.hx - 0.2;
+  d->qpos[1] = o.y;
+  d->qpos[2] = s.platform_z + c.robot.wheel_radius + 0.005;
+  d->qpos[3] = 1;
+  d->qpos[4] = d->qpos[5] = d->qpos[6] = 0;
+  mj_forward(env.world().model(), d);
+  Termination reason = Termination::none;
+  for (int t = 0; t < 100 && !env.done(); ++t) reason = env.step(forward, control::MotionMode::flat).reason;
+  EXPECT_EQ(reason, Termination::collision);
+
+  // Overturned: module 1 upside down.
+  env.reset(spec(3, 3));
+  d = env.mutable_world().mutable_data();
+  d->qpos[2] = 0.3;
+  d->qpos[3] = 0;
+  d->qpos[4] = 1;  // 180 deg about x
+  mj_forward(env.world().model(), d);
+  EXPECT_EQ(env.step(forward, control::MotionMode::flat).reason, Termination::overturned);
+
+  // Step cap truncates.
+  task::EnvConfig short_cfg = c;
+  short_cfg.task.max_steps = 5;
+  task::MultiTaskEnv capped(short_cfg);
+  capped.reset(spec(3, 2));
+  const float still[5] = {0.0f, 0.0f, -1.0f, 0.0f, -1.0f};
+  for (int t = 0; t < 4; ++t) EXPECT_FALSE(capped.step(still).truncated);
+  const task::StepResult& r = capped.step(still);
+  EXPECT_TRUE(r.truncated);
+  EXPECT_FALSE(r.terminated);
+  EXPECT_EQ(r.reason, Termination::step_cap);
+}
+
+TEST(Env, ReconfigurationMidEpisodeKeepsTheHeadAndUpdatesTheMask) {
+  const task::EnvConfig c;
+  task::MultiTaskEnv env(c);
+  env.reset(spec(4, 6, 0.06, 6));
+  const float a[5] = {1.0f, 0.0f, 0.5f, -0.5f, 0.5f};
+  for (int t = 0; t < 80; ++t) env.step(a, control::MotionMode::stair);
+  const double x = env.world().module_pos(0)[0], e = env.metrics().energy_J;
+  const std::vector<float> dist(env.state() + task::obs::kDistances, env.state() + task::obs::kDistances + 6);
+  env.reconfigure(3);
+  EXPECT_EQ(env.modules(), 3);
+  EXPECT_EQ(env.initial_modules(), 6);
+  EXPECT_EQ(env.world().module_pos(0)[0], x);
+  EXPECT_NEAR(env.metrics().energy_J, e, 1e-9);  // shed modules still count (summed in another order)
+  for (int k = 0; k < 10; ++k) EXPECT_EQ(env.state()[task::obs::kModuleMask + k], k < 3 ? 1.0f : 0.0f);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(env.state()[task::obs::kDistances + i], dist[i]);
+  EXPECT_THROW(env.reconfigure(4), std::invalid_argument);
+  for (int t = 0; t < 20; ++t) env.step(a, control::MotionMode::stair);
+  EXPECT_GT(env.world().module_pos(0)[0], x);
+}
+
+TEST(Env, DatasetDepthFromArbitraryPoses) {
+  const task::EnvConfig c;
+  task::MultiTaskEnv env(c);
+  env.reset(spec(8, 3, 0.08, 6));
+  const sim::SceneLayout& s = env.world().layout();
+  std::vector<float> near(c.robot.depth_width * c.robot.depth_height), far(near.size());
+  // Facing the stairs from close up and from far: the riser is nearer in the first.
+  const double close[3] = {-0.3, 0, c.robot.camera_height};
+  const double away[3] = {-1.5, 0, c.robot.camera_height};
+  env.world().render_depth_at(close, 0.0, 0.0, near.data());
+  env.world().render_depth_at(away, 0.0, 0.0, far.data());
+  const int mid = (c.robot.depth_height / 2) * c.robot.depth_width + c.robot.depth_width / 2;
+  EXPECT_LT(near[mid], far[mid]);
+  EXPECT_EQ(sim::scene_label(c.scene, s, close[0], close[1]), sim::kLabelStairs);
+}
