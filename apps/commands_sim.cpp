@@ -100,8 +100,8 @@ void run_demo(const SimOptions& o) {
       o.modules, o.seed, s.stair_height, s.obstacles.size(), sim::variant_name(s.variant), s.target_x,
       s.target_y, env.metrics().initial_distance_m);
   task::ScriptedPilot pilot;
-  // The stair gait of the physics-table search that climbs all three heights for 4+ modules.
-  pilot.params().gait = {1.0f, 1.0f, -0.2f, 1.0f};
+  // The stair gait the physics-table search picks (full amplitude, wave lag -0.5).
+  pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};
   pilot.plan(env);
   float action[control::kActionSize];
   control::MotionMode mode = env.mode(), last_mode = env.mode();

@@ -50,7 +50,7 @@ struct RobotParams {
   double distance_height = 0.08;  // m above ground
   // ---- energy ----
   double battery_capacity = 20000.0;  // J per module
-  double idle_power = 18.5;           // W per module: electronics, radio, camera share (calibrated, docs/sim.md)
+  double idle_power = 20.0;           // W per module: electronics, radio, camera share (calibrated, docs/sim.md)
   double motor_efficiency = 0.6;      // mechanical / electrical power of a motor
   double copper_loss = 3.0;           // W per (N m)^2 of motor torque (holding costs too)
   // ---- timing ----

@@ -286,6 +286,14 @@ void World::render_depth(float* out) const {
   }
 }
 
+int World::render_view_from(double x, double y, double yaw, float* out) const {
+  const double half = 0.5 * robot_.module_length;
+  const double pos[3] = {x + half * std::cos(yaw), y + half * std::sin(yaw),
+                         floor_height(layout_, x, y) + robot_.camera_height};
+  render_depth_at(pos, yaw, 0.0, out);
+  return scene_label(scene_, layout_, x, y);
+}
+
 void World::read_distances(float* out) const {
   const double range = robot_.distance_range;
   for (int k = 0; k < modules_; ++k) {

@@ -54,6 +54,10 @@ class World {
   // The same camera placed at an arbitrary pose: the camera's position (m, scene
   // frame) and the heading (yaw, rad) and pitch-up (rad) of the module carrying it.
   void render_depth_at(const double pos[3], double yaw, double pitch, float* out) const;
+  // Dataset helper: the image module 1's camera would see standing level on the
+  // floor at (x, y) (m) with heading yaw (rad); returns the ground-truth
+  // scene_label of that position. Uses the scene of the last reset().
+  int render_view_from(double x, double y, double yaw, float* out) const;
   // Left and right distance per module, normalised by distance_range, in [0, 1]:
   // out[2k] = left of module k, out[2k+1] = right (1 = nothing within range).
   void read_distances(float* out) const;

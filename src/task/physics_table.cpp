@@ -6,10 +6,11 @@
 namespace comorph::task {
 
 ClimbTrial run_climb_trial(const EnvConfig& config, int modules, double stair_height, std::uint64_t seed,
-                           const StairGait& gait, const PhysicsTableOptions& o) {
+                           const StairGait& gait, const PhysicsTableOptions& o,
+                           std::shared_ptr<sim::ModelCache> cache) {
   EnvConfig c = config;
   c.task.max_steps = int(o.time_limit_s / c.robot.control_period) + 1;
-  MultiTaskEnv env(c);
+  MultiTaskEnv env(c, std::move(cache));
   EpisodeSpec spec;
   spec.seed = seed;
   spec.modules = modules;
@@ -45,9 +46,10 @@ ClimbTrial run_climb_trial(const EnvConfig& config, int modules, double stair_he
   return t;
 }
 
-double measure_turn_rate(const EnvConfig& config, int modules, double seconds) {
-  EnvConfig c = config;
-  MultiTaskEnv env(c);
+double measure_turn_rate(const EnvConfig& config, int modules, double seconds,
+                         std::shared_ptr<sim::ModelCache> cache) {
+  const EnvConfig& c = config;
+  MultiTaskEnv env(c, std::move(cache));
   EpisodeSpec spec;
   spec.modules = modules;
   spec.obstacles = 0;
@@ -80,14 +82,15 @@ std::vector<PhysicsRow> physics_table(const EnvConfig& config, const PhysicsTabl
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::vector<PhysicsRow> rows;
   const int total = int(o.modules.size() * heights.size());
+  auto cache = std::make_shared<sim::ModelCache>(config.robot, config.scene);
   for (int n : o.modules) {
-    const double turn = measure_turn_rate(config, n, o.turn_time_s);
+    const double turn = measure_turn_rate(config, n, o.turn_time_s, cache);
     for (double h : heights) {
       // Search on seed 1000 (not an evaluation seed): climbed first, then time.
       StairGait best = candidates.front();
       double best_score = -1e18;
       for (const StairGait& g : candidates) {
-        const ClimbTrial t = run_climb_trial(config, n, h, 1000, g, o);
+        const ClimbTrial t = run_climb_trial(config, n, h, 1000, g, o, cache);
         const double score = t.climbed ? 1000.0 - t.time_s : t.progress_m;
         if (score > best_score) best_score = score, best = g;
       }
@@ -99,7 +102,7 @@ std::vector<PhysicsRow> physics_table(const EnvConfig& config, const PhysicsTabl
       int ok = 0;
       double time = 0, energy = 0;
       for (int s = 0; s < o.seeds; ++s) {
-        const ClimbTrial t = run_climb_trial(config, n, h, std::uint64_t(s + 1), best, o);
+        const ClimbTrial t = run_climb_trial(config, n, h, std::uint64_t(s + 1), best, o, cache);
         if (t.climbed) ++ok, time += t.time_s, energy += t.energy_J;
       }
       row.climbed = double(ok) / o.seeds;

@@ -44,10 +44,13 @@ struct PhysicsRow {
 };
 
 // One climbing trial: stairs only (no obstacles), the pilot in stair mode with `gait`.
+// `cache` (optional) shares compiled models between trials.
 ClimbTrial run_climb_trial(const EnvConfig& config, int modules, double stair_height, std::uint64_t seed,
-                           const StairGait& gait, const PhysicsTableOptions& options);
+                           const StairGait& gait, const PhysicsTableOptions& options,
+                           std::shared_ptr<sim::ModelCache> cache = nullptr);
 // Yaw rate (deg/s) of a chain turning on the spot in flat mode on flat ground.
-double measure_turn_rate(const EnvConfig& config, int modules, double seconds);
+double measure_turn_rate(const EnvConfig& config, int modules, double seconds,
+                         std::shared_ptr<sim::ModelCache> cache = nullptr);
 
 // progress(row_index, total_rows, row) is called after each row (may be empty).
 std::vector<PhysicsRow> physics_table(const EnvConfig& config, const PhysicsTableOptions& options,

@@ -223,3 +223,18 @@ TEST(Env, DatasetDepthFromArbitraryPoses) {
   EXPECT_LT(near[mid], far[mid]);
   EXPECT_EQ(sim::scene_label(c.scene, s, close[0], close[1]), sim::kLabelStairs);
 }
+
+TEST(Env, LabelledViewsForTheSceneClassifier) {
+  const task::EnvConfig c;
+  task::MultiTaskEnv env(c);
+  env.reset(spec(12, 2, 0.06, 6));
+  const sim::SceneLayout& s = env.world().layout();
+  std::vector<float> img(c.robot.depth_width * c.robot.depth_height);
+  EXPECT_EQ(env.world().render_view_from(-0.8, 0.0, 0.0, img.data()), sim::kLabelStairs);
+  EXPECT_EQ(env.world().render_view_from(s.platform_x + 1.0, 0.0, 0.0, img.data()), sim::kLabelObstacles);
+  EXPECT_EQ(env.world().render_view_from(s.target_x - 0.5, s.target_y, 0.0, img.data()), sim::kLabelTarget);
+  // Standing on the flat area the camera is raised by the stairs' height: compare to the ground view.
+  std::vector<float> ground(img.size());
+  env.world().render_view_from(-0.8, 0.0, 0.0, ground.data());
+  EXPECT_NE(img, ground);
+}
