@@ -103,8 +103,18 @@ torch::Device parse_device(const std::string& device) {
 
 SceneClassifier::SceneClassifier(const ClassifierParams& params, std::uint64_t seed) {
   check_params(params);
-  torch::manual_seed(seed);
-  impl_ = std::make_unique<Impl>(params, parse_device(params.device));
+  // Initialise from `seed` without disturbing the global generator that
+  // other torch users (the RL learners) draw from.
+  auto generator = at::detail::getDefaultCPUGenerator();
+  const torch::Tensor saved = generator.get_state();
+  generator.set_current_seed(seed);
+  try {
+    impl_ = std::make_unique<Impl>(params, parse_device(params.device));
+  } catch (...) {
+    generator.set_state(saved);
+    throw;
+  }
+  generator.set_state(saved);
   impl_->net->eval();
 }
 

@@ -25,7 +25,8 @@ namespace comorph::perception {
 
 class SceneClassifier {
  public:
-  // Fresh (untrained) weights, initialised from `seed`.
+  // Fresh (untrained) weights, initialised from `seed` (torch's global CPU
+  // generator is restored afterwards, so other torch users are not disturbed).
   explicit SceneClassifier(const ClassifierParams& params, std::uint64_t seed = 1);
   ~SceneClassifier();
   SceneClassifier(SceneClassifier&&) noexcept;
