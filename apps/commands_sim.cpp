@@ -53,8 +53,10 @@ void run_physics_table(const SimOptions& o) {
   task::PhysicsTableOptions opt;
   opt.seeds = o.seeds;
   if (o.quick) opt.modules = {2, 6};
-  std::cerr << "physics-table: stair-gait search (" << opt.amplitudes.size() * opt.phases.size()
-            << " candidates max) + " << opt.seeds << " seeds per row\n";
+  std::cerr << fmt::format(
+      "physics-table: per row a stair-gait search over a2=a4 x a3 ({} x {} grid, seed 1000), then {} seeds; "
+      "{} rows\n",
+      opt.amplitudes.size(), opt.phases.size(), opt.seeds, opt.modules.size() * 3);
   const auto rows = task::physics_table(c, opt, [](int i, int total, const task::PhysicsRow& r) {
     std::cerr << fmt::format("  [{}/{}] {} modules, {:.2f} m: climbed {:.2f}\n", i, total, r.modules,
                              r.stair_height_m, r.climbed);

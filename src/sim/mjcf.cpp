@@ -125,7 +125,7 @@ std::string build_mjcf(int n, const RobotParams& p, const SceneParams& sp, const
   }
   // Target: a thin post the depth camera sees, and a disc of the target radius (decoration).
   out += fmt::format(
-      "    <geom name=\"target\" type=\"cylinder\" size=\"0.04 0.2\" pos=\"{0:.9g} {1:.9g} {2:.9g}\" "
+      "    <geom name=\"target\" type=\"cylinder\" size=\"0.08 0.2\" pos=\"{0:.9g} {1:.9g} {2:.9g}\" "
       "rgba=\"0.1 0.8 0.2 1\" contype=\"0\" conaffinity=\"0\" group=\"0\"/>\n"
       "    <geom name=\"target_zone\" type=\"cylinder\" size=\"{3:.6g} 0.002\" pos=\"{0:.9g} {1:.9g} {4:.9g}\" "
       "rgba=\"0.1 0.8 0.2 0.3\" contype=\"0\" conaffinity=\"0\" group=\"2\"/>\n",

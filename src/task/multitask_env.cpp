@@ -64,10 +64,7 @@ double MultiTaskEnv::goal_distance() const {
 }
 
 control::MotionMode MultiTaskEnv::default_mode() const {
-  const double head_x = world_.module_pos(0)[0];
-  if (!stairs_climbed() && head_x < world_.layout().platform_x + 0.5 * config_.scene.tread + 0.3)
-    return control::MotionMode::stair;
-  return control::MotionMode::flat;
+  return stairs_climbed() ? control::MotionMode::flat : control::MotionMode::stair;
 }
 
 bool MultiTaskEnv::check_climbed() const {

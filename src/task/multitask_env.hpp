@@ -93,7 +93,7 @@ class MultiTaskEnv {
   // Sheds tail modules (only to fewer, >= 2); carries the kept modules' state exactly.
   void reconfigure(int modules);
 
-  // stair while the stairs are not climbed and module 1 is not past them, else flat.
+  // Ground truth: stair until the whole chain is on the top of the stairs, then flat.
   control::MotionMode default_mode() const;
 
   // ---- observations (valid until the next step/reset) ----
