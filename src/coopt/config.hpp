@@ -1,0 +1,92 @@
+// One run of the hierarchical co-optimization = one YAML file (configs/paper.yaml,
+// quick.yaml, ci.yaml) with these sections, every key optional:
+//
+//   trainer:    TrainerParams below (episodes, schedules, threads, scene source, ...)
+//   td3:        rl::Td3Config fields   (motion model, trainer.motion_algo: td3)
+//   sac:        rl::SacConfig fields   (motion model, trainer.motion_algo: sac)
+//   dqn:        rl::DqnConfig fields   (configuration model)
+//   env:        {robot, scene, motion, task}: overrides of configs/sim/*.yaml
+//   perception: {classifier, switch_detector} (configs/perception.yaml layout)
+//   eval:       EvalParams below
+//
+// `--set a.b.c=value` overrides any key (value parsed as YAML, so lists work).
+// Unknown keys and out-of-range values throw std::runtime_error naming the
+// source and the dotted key. No torch in this header: the CLI includes it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "perception/perception_config.hpp"
+#include "task/env_config.hpp"
+
+namespace comorph::coopt {
+
+// Candidates of the configuration model: chains of kMinModules..kMaxModules.
+inline constexpr int kMinModules = 2;
+inline constexpr int kMaxModules = 10;
+inline constexpr int kCandidates = kMaxModules - kMinModules + 1;  // 9 Q values
+
+struct TrainerParams {
+  std::string mode = "hierarchical";  // hierarchical (DQN picks the chain) | fixed (fixed_modules, no DQN)
+  int fixed_modules = 4;              // chain length of the fixed baseline, 2..10
+  std::string motion_algo = "td3";    // motion learner: td3 | sac
+  int seed = 1;                       // seeds learners, trainer RNG and the training scenes
+  int warmup_episodes = 300;          // episodes of uniform random actions (both models) before learning acts
+  int episodes = 4000;                // training episodes after the warm-up
+  // Motion-model updates run on a learner thread, overlapped with the
+  // simulation: every `sync_interval` control steps (and at every episode end)
+  // the acting thread hands its transitions over, waits for the previous
+  // batch of updates and copies the new actor weights. The schedule does not
+  // depend on timing, so both thread modes give identical results.
+  int sync_interval = 64;             // control steps between hand-overs (the acting policy lags by <= 2 of these)
+  bool learner_thread = true;         // false: run the updates inline (one core, same results)
+  int torch_threads = 1;              // torch intra-op threads per thread (1: small nets, reproducible)
+  bool motion_image = true;           // the motion model sees the depth image (CNN) + state; false: state only
+  bool config_vector = true;          // the DQN sees [C_n / 10, scene one-hot x3] beside the depth image
+  std::string scene_source = "ground_truth";  // ground_truth (simulator labels) | classifier (ResNet-18 on depth)
+  std::string classifier_dir;         // trained classifier directory (scene_source: classifier)
+  std::string scenario = "default";   // training scene: default | obstacles7 | obstacles8 | mixed
+  double stair_height = 0;            // m; 0 = drawn per episode from {0.04, 0.06, 0.08}; > 0 fixed (reduced tasks)
+  int eval_interval = 100;            // training episodes between periodic greedy evaluations (0 = none)
+  int eval_episodes = 6;              // episodes per periodic evaluation (heights cycle 0.04, 0.06, 0.08)
+  int eval_seed = 900000;             // seed of periodic evaluation episode i is eval_seed + i
+  int checkpoint_interval = 10;       // training episodes between checkpoints (and at the end / Ctrl-C)
+  int progress_interval = 1;          // training episodes between progress lines on stderr
+  std::string env_dir;                // base env configs (robot/scene/motion/task.yaml); "" = <source>/configs/sim
+};
+
+// `comorph eval` defaults (the command line overrides them).
+struct EvalParams {
+  int episodes = 30;     // greedy episodes; stair height of episode i = heights[i % 3]
+  int seed = 700000;     // seed of episode i is seed + i
+  int workers = 2;       // threads, each with its own env and network copies
+  double w_t = 1.0;      // F(H) weights for eval-<scenario>.json (report::FWeights defaults,
+  double w_e = 2.0;      //   fitted to the paper's tables: docs/report.md)
+  double w_d = 2.0;
+};
+
+struct CooptConfig {
+  TrainerParams trainer;
+  EvalParams eval;
+  task::EnvConfig env;                         // configs/sim + the env: overrides
+  perception::PerceptionConfig perception;     // classifier + switch detector
+  // The learner sections, validated here and parsed again by the torch side.
+  std::string td3_yaml, sac_yaml, dqn_yaml;
+  // The merged YAML (file + --set): what the run directory's config.yaml holds
+  // and what a checkpoint is compared against.
+  std::string text;
+  std::string preset;                          // file stem, e.g. "quick"
+};
+
+// Loads `path`, applies `sets` ("a.b=value"), validates every section.
+CooptConfig load_coopt_config(const std::string& path, const std::vector<std::string>& sets = {});
+// The same from YAML text (source names it in errors).
+CooptConfig coopt_config_from_text(const std::string& text, const std::string& source,
+                                   const std::vector<std::string>& sets = {});
+
+// Scenario name -> obstacles (K; -1 = scene default) and mixed variant flag; throws if unknown.
+void scenario_settings(const std::string& scenario, int& obstacles, bool& mixed);
+
+}  // namespace comorph::coopt

@@ -1,0 +1,51 @@
+// The configuration model's semi-MDP bookkeeping (paper Algorithm 1), torch-free:
+// - candidate masks: at the episode start every chain of 2..10 modules is
+//   valid; after a choice of C_n modules only [2, C_n] (the robot can only
+//   shed tail modules);
+// - the segment a decision governs: its summed R1, its length k in control
+//   steps, whether it started before the stairs were climbed, whether the r_s
+//   event happened in it, and the stair energy E_c spent during it -> R2 (Eq. 7).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "coopt/config.hpp"
+#include "task/rewards.hpp"
+
+namespace comorph::coopt {
+
+// Candidate index <-> modules (index 0 = 2 modules ... 8 = 10 modules).
+inline int modules_of(int candidate) { return candidate + kMinModules; }
+inline int candidate_of(int modules) { return modules - kMinModules; }
+
+// Valid-action mask over the 9 candidates: 1 for chains of 2..max_modules.
+std::vector<std::uint8_t> candidate_mask(int max_modules);
+void candidate_mask(int max_modules, std::vector<std::uint8_t>& mask);  // no allocation once sized
+
+// One configuration decision's segment.
+class Segment {
+ public:
+  // The decision is made now: stairs_climbed = the r_s event already happened
+  // in this episode; stair_energy_J = the env's E_c counter so far.
+  void begin(bool stairs_climbed, double stair_energy_J);
+  // After each control step: its R1 and whether the r_s event happened in it.
+  void add_step(double r1, bool stairs_climbed_now);
+  // R2 (Eq. 7) of the segment so far; stair_energy_J = the env's E_c counter now.
+  double r2(const task::R2Params& params, double stair_height_m, double stair_energy_J) const;
+
+  int steps() const { return steps_; }           // k of the semi-MDP transition (control steps)
+  double sum_r1() const { return sum_r1_; }      // summed R1 of the segment
+  bool stairs_segment() const { return stairs_segment_; }  // began before the stairs were climbed
+  bool climbed() const { return climbed_; }      // r_s earned in this segment
+
+ private:
+  int steps_ = 0;
+  double sum_r1_ = 0;
+  bool stairs_segment_ = false;
+  bool climbed_ = false;
+  double energy_at_start_J_ = 0;
+};
+
+}  // namespace comorph::coopt

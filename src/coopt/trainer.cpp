@@ -1,0 +1,724 @@
+// The hierarchical trainer and the evaluator (see trainer.hpp for the loop).
+#include "coopt/trainer.hpp"
+
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "coopt/segment.hpp"
+#include "perception/scene_classifier.hpp"
+#include "perception/scene_monitor.hpp"
+#include "perception/switch_detector.hpp"
+#include "rl/dqn.hpp"
+#include "rl/sac.hpp"
+#include "rl/td3.hpp"
+#include "sim/scene.hpp"
+#include "task/multitask_env.hpp"
+
+namespace comorph::coopt {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr int kConfigVector = 4;  // C_n / 10, scene one-hot (stairs, obstacles, target)
+using Clock = std::chrono::steady_clock;
+
+// ---------------------------------------------------------------------------
+// Learners
+
+rl::ObservationSpec motion_spec(const CooptConfig& c) {
+  rl::ObservationSpec s;
+  if (c.trainer.motion_image) {
+    s.image_channels = 1;
+    s.image_height = c.env.robot.depth_height;
+    s.image_width = c.env.robot.depth_width;
+  }
+  s.vector_size = task::obs::kStateSize;
+  return s;
+}
+
+rl::ObservationSpec config_spec(const CooptConfig& c) {
+  rl::ObservationSpec s;
+  s.image_channels = 1;
+  s.image_height = c.env.robot.depth_height;
+  s.image_width = c.env.robot.depth_width;
+  s.vector_size = c.trainer.config_vector ? kConfigVector : 0;
+  return s;
+}
+
+// The motion learner; `replica` = the acting copy (one-slot replay).
+std::unique_ptr<rl::Learner> make_motion(const CooptConfig& c, std::uint64_t seed, bool replica) {
+  const rl::ObservationSpec spec = motion_spec(c);
+  if (c.trainer.motion_algo == "sac") {
+    rl::SacConfig cfg = rl::SacConfig::from_yaml(YAML::Load(c.sac_yaml), "sac");
+    cfg.random_action_episodes = c.trainer.warmup_episodes;
+    if (replica) cfg.buffer_size = 1;
+    return std::make_unique<rl::Sac>(spec, control::kActionSize, cfg, seed);
+  }
+  rl::Td3Config cfg = rl::Td3Config::from_yaml(YAML::Load(c.td3_yaml), "td3");
+  cfg.random_action_episodes = c.trainer.warmup_episodes;
+  if (replica) cfg.buffer_size = 1;
+  return std::make_unique<rl::Td3>(spec, control::kActionSize, cfg, seed);
+}
+
+rl::ActorCritic& networks_of(rl::Learner& l) {
+  if (auto* t = dynamic_cast<rl::Td3*>(&l)) return t->networks();
+  if (auto* s = dynamic_cast<rl::Sac*>(&l)) return s->networks();
+  throw std::logic_error("motion learner is neither TD3 nor SAC");
+}
+
+std::unique_ptr<rl::Dqn> make_config_model(const CooptConfig& c, std::uint64_t seed) {
+  if (c.trainer.mode != "hierarchical") return nullptr;
+  const rl::DqnConfig cfg = rl::DqnConfig::from_yaml(YAML::Load(c.dqn_yaml), "dqn");
+  return std::make_unique<rl::Dqn>(config_spec(c), kCandidates, cfg, seed);
+}
+
+// ---------------------------------------------------------------------------
+// Scene source: the switch detector on ground-truth labels or on the classifier.
+
+class SceneSource {
+ public:
+  explicit SceneSource(const CooptConfig& c) : params_(c.perception.switch_detector), detector_(params_, 0, 3) {
+    if (c.trainer.scene_source == "classifier") {
+      classifier_ = std::make_unique<perception::SceneClassifier>(
+          perception::SceneClassifier::load(c.trainer.classifier_dir, &c.perception.classifier));
+      monitor_ = std::make_unique<perception::SceneMonitor>(*classifier_, params_, 0);
+    }
+  }
+  std::function<int(int, int)> label_source;  // optional relabelling of the ground truth
+
+  void reset(const task::MultiTaskEnv& env) {
+    step_ = 0;
+    if (monitor_) {
+      const int first = classifier_->classify(env.depth(), env.depth_height(), env.depth_width());
+      monitor_->reset(first);
+    } else {
+      detector_.reset(label(env));
+    }
+  }
+  perception::SwitchDecision step(const task::MultiTaskEnv& env) {
+    ++step_;
+    return monitor_ ? monitor_->step(env.depth()) : detector_.step(label(env));
+  }
+  int current() const { return monitor_ ? monitor_->current_scene() : detector_.current_scene(); }
+
+ private:
+  int label(const task::MultiTaskEnv& env) const {
+    return label_source ? label_source(step_, env.scene_label()) : env.scene_label();
+  }
+  int step_ = 0;  // control steps since reset
+  perception::SwitchDetectorParams params_;
+  perception::SwitchDetector detector_;
+  std::unique_ptr<perception::SceneClassifier> classifier_;
+  std::unique_ptr<perception::SceneMonitor> monitor_;
+};
+
+// ---------------------------------------------------------------------------
+// What acts in an episode: the motion actor and the configuration model.
+
+struct Agent {
+  std::unique_ptr<rl::Learner> motion;   // acting copy of the motion model
+  std::unique_ptr<rl::Dqn> config;       // nullptr in fixed mode
+};
+
+// Training hooks of one episode (absent for evaluation).
+struct LearnHooks {
+  std::function<void(const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool)> motion;
+  std::function<void(const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool, int)>
+      config;
+  std::function<int(const std::vector<std::uint8_t>&)> random_config;  // warm-up choice, -1 = ask the DQN
+};
+
+// Reusable buffers of an episode runner (no allocation in the step loop).
+struct Buffers {
+  rl::Observation obs, next, cobs, cnext;
+  rl::Action action, caction;
+  std::vector<std::uint8_t> mask;
+};
+
+void fill_motion(const task::MultiTaskEnv& env, bool image, rl::Observation& o) {
+  if (image) std::copy(env.depth(), env.depth() + o.image.size(), o.image.begin());
+  std::copy(env.state(), env.state() + task::obs::kStateSize, o.vector.begin());
+}
+
+void fill_config(const task::MultiTaskEnv& env, int max_modules, int scene, bool vector, Buffers& b,
+                 rl::Observation& o) {
+  std::copy(env.depth(), env.depth() + o.image.size(), o.image.begin());
+  if (vector) {
+    o.vector[0] = static_cast<float>(max_modules) / kMaxModules;
+    for (int k = 0; k < 3; ++k) o.vector[1 + k] = scene == k ? 1.0f : 0.0f;
+  }
+  candidate_mask(max_modules, b.mask);
+  o.valid_actions = b.mask;
+}
+
+control::MotionMode mode_of(int scene) {
+  return scene == sim::kLabelStairs ? control::MotionMode::stair : control::MotionMode::flat;
+}
+
+// One episode; learn == hooks present. The env is reset here.
+EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, SceneSource& scene,
+                task::EpisodeSpec spec, bool explore, const LearnHooks* hooks, Buffers& b) {
+  EpisodeLog log;
+  const bool hierarchical = agent.config != nullptr;
+  const bool image = c.trainer.motion_image;
+  int modules = c.trainer.fixed_modules;
+  double return_r2 = 0;
+  auto choose = [&](rl::Observation& o) {
+    int a = hooks && hooks->random_config ? hooks->random_config(b.mask) : -1;
+    if (a < 0) {
+      agent.config->act(o, explore, b.caction);
+      a = b.caction.discrete;
+    }
+    b.caction.discrete = a;
+    return modules_of(a);
+  };
+
+  // 1. The first configuration decision, on the first depth image (module 1's
+  //    camera does not depend on the chain behind it).
+  if (hierarchical) {
+    spec.modules = kMaxModules;
+    env.reset(spec);
+    scene.reset(env);
+    fill_config(env, kMaxModules, scene.current(), c.trainer.config_vector, b, b.cobs);
+    modules = choose(b.cobs);
+  }
+  spec.modules = modules;
+  env.reset(spec);
+  scene.reset(env);
+  log.configurations.push_back(modules);
+  log.modules_total = modules;
+  Segment segment;
+  segment.begin(false, 0.0);
+
+  // 2. Control steps.
+  fill_motion(env, image, b.obs);
+  const task::StepResult* r = nullptr;
+  while (true) {
+    agent.motion->act(b.obs, explore, b.action);
+    r = &env.step(b.action.continuous.data(), mode_of(scene.current()));
+    segment.add_step(r->reward, r->stairs_climbed_now);
+    log.return_R1 += r->reward;
+    fill_motion(env, image, b.next);
+    const bool done = r->terminated || r->truncated;
+    if (hooks) hooks->motion(b.obs, b.action, static_cast<float>(r->reward), b.next, r->terminated, r->truncated);
+    std::swap(b.obs, b.next);
+    if (done) break;
+    const perception::SwitchDecision d = scene.step(env);
+    if (!d.switched) continue;
+    ++log.switches;
+    if (!hierarchical) continue;
+    // 3. A declared switch ends the segment: one semi-MDP transition, then a
+    //    new decision among [2, C_n].
+    const double r2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
+    return_r2 += r2;
+    fill_config(env, modules, scene.current(), c.trainer.config_vector, b, b.cnext);
+    if (hooks) hooks->config(b.cobs, b.caction, static_cast<float>(r2), b.cnext, false, false, segment.steps());
+    std::swap(b.cobs, b.cnext);
+    const int next_modules = choose(b.cobs);
+    if (next_modules < modules) {
+      env.reconfigure(next_modules);
+      modules = next_modules;
+      fill_motion(env, image, b.obs);
+    }
+    if (log.configurations.back() != modules) log.configurations.push_back(modules);
+    segment.begin(env.stairs_climbed(), env.stairs_energy());
+  }
+  // 4. The last segment.
+  if (hierarchical) {
+    const double r2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
+    return_r2 += r2;
+    fill_config(env, modules, scene.current(), c.trainer.config_vector, b, b.cnext);
+    if (hooks)
+      hooks->config(b.cobs, b.caction, static_cast<float>(r2), b.cnext, r->terminated, r->truncated, segment.steps());
+  }
+
+  const task::Metrics m = env.metrics();
+  log.seed = spec.seed;
+  log.scenario = c.trainer.scenario;
+  log.stair_height_m = env.stair_height();
+  log.obstacles = static_cast<int>(env.world().layout().obstacles.size());
+  log.success = r->reason == task::Termination::success;
+  log.termination = task::termination_name(r->reason);
+  log.time_s = m.time_s;
+  log.energy_J = m.energy_J;
+  log.distance_fraction = m.D;
+  log.F = m.F;
+  log.return_R2 = return_r2;
+  log.steps = m.steps;
+  log.stairs_energy_J = env.stairs_energy();
+  return log;
+}
+
+void allocate_buffers(const CooptConfig& c, Buffers& b) {
+  rl::allocate(motion_spec(c), b.obs);
+  rl::allocate(motion_spec(c), b.next);
+  rl::allocate(config_spec(c), b.cobs);
+  rl::allocate(config_spec(c), b.cnext);
+  b.action.continuous.assign(control::kActionSize, 0.0f);
+}
+
+// The scene spec of an evaluation episode (heights cycle 0.04, 0.06, 0.08).
+task::EpisodeSpec eval_spec(const CooptConfig& c, const std::string& scenario, std::uint64_t seed, int i) {
+  task::EpisodeSpec spec;
+  spec.seed = seed;
+  const double heights[3] = {c.env.scene.stair_height_a, c.env.scene.stair_height_b, c.env.scene.stair_height_c};
+  spec.stair_height = c.trainer.stair_height > 0 ? c.trainer.stair_height : heights[i % 3];
+  bool mixed = false;
+  scenario_settings(scenario, spec.obstacles, mixed);
+  spec.variant = mixed ? sim::Variant::mixed : sim::Variant::standard;
+  return spec;
+}
+
+// ---------------------------------------------------------------------------
+// The learner thread: runs one job at a time (store + updates of an interval).
+
+class LearnerWorker {
+ public:
+  explicit LearnerWorker(bool threaded) : threaded_(threaded) {
+    if (threaded_) thread_ = std::thread([this] { loop(); });
+  }
+  ~LearnerWorker() {
+    if (!threaded_) return;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      quit_ = true;
+    }
+    cv_.notify_all();
+    thread_.join();
+  }
+  void submit(std::function<void()> job) {
+    if (!threaded_) {
+      job();
+      return;
+    }
+    wait();
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      job_ = std::move(job);
+      pending_ = true;
+    }
+    cv_.notify_all();
+  }
+  void wait() {
+    if (!threaded_) return;
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait(lock, [this] { return !pending_; });
+    if (error_) {
+      auto e = error_;
+      error_ = nullptr;
+      std::rethrow_exception(e);
+    }
+  }
+
+ private:
+  void loop() {
+    while (true) {
+      std::function<void()> job;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait(lock, [this] { return pending_ || quit_; });
+        if (quit_ && !pending_) return;
+        job = std::move(job_);
+      }
+      try {
+        job();
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        error_ = std::current_exception();
+      }
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        pending_ = false;
+      }
+      cv_.notify_all();
+    }
+  }
+  bool threaded_;
+  std::thread thread_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::function<void()> job_;
+  bool pending_ = false, quit_ = false;
+  std::exception_ptr error_;
+};
+
+struct Transition {
+  rl::Observation obs, next;
+  rl::Action action;
+  float reward = 0;
+  bool terminated = false, truncated = false;
+};
+
+std::string checkpoint_dir(const std::string& run) { return (fs::path(run) / "checkpoint").string(); }
+
+void write_text_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::trunc);
+  out << text;
+  out.flush();
+  if (!out) throw std::runtime_error("cannot write " + path);
+}
+
+std::string first_difference(const std::string& a, const std::string& b) {
+  std::istringstream sa(a), sb(b);
+  std::string la, lb;
+  int line = 0;
+  while (true) {
+    const bool ga = static_cast<bool>(std::getline(sa, la));
+    const bool gb = static_cast<bool>(std::getline(sb, lb));
+    ++line;
+    if (!ga && !gb) return "";
+    if (!ga || !gb || la != lb)
+      return "line " + std::to_string(line) + ": checkpoint has '" + (gb ? lb : "<end>") + "', config has '" +
+             (ga ? la : "<end>") + "'";
+  }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+
+CheckpointInfo read_checkpoint_info(const std::string& run_dir) {
+  std::string dir = checkpoint_dir(run_dir);
+  // A crash between the two renames of a checkpoint leaves only checkpoint.old.
+  if (!fs::exists(fs::path(dir) / "trainer.yaml") && fs::exists(fs::path(dir + ".old") / "trainer.yaml"))
+    dir += ".old";
+  const std::string path = (fs::path(dir) / "trainer.yaml").string();
+  if (!fs::exists(path)) throw std::runtime_error(run_dir + ": no checkpoint (expected " + path + ")");
+  YAML::Node n;
+  try {
+    n = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(path + ": unreadable checkpoint: " + e.what());
+  }
+  CheckpointInfo info;
+  info.episodes = n["episodes"].as<int>();
+  info.evaluations = n["evaluations"].as<int>();
+  info.env_steps = n["env_steps"].as<std::int64_t>();
+  info.wall_s = n["wall_s"].as<double>();
+  info.config_text = n["config"].as<std::string>();
+  info.directory = dir;
+  return info;
+}
+
+void truncate_csv_rows(const std::string& path, int rows) {
+  if (!fs::exists(path)) return;
+  std::ifstream in(path);
+  std::string text, line;
+  int kept = -1;  // the header is row -1
+  while (kept < rows && std::getline(in, line)) {
+    text += line + "\n";
+    ++kept;
+  }
+  in.close();
+  const std::string tmp = path + ".tmp";
+  write_text_file(tmp, text);
+  fs::rename(tmp, path);
+}
+
+struct Trainer::Impl {
+  CooptConfig config;
+  std::string run_dir;
+  TrainerCallbacks callbacks;
+
+  std::unique_ptr<rl::Learner> learner;  // full motion learner (learner thread)
+  Agent agent;                           // acting copy + configuration model (acting thread)
+  task::MultiTaskEnv env;
+  SceneSource scene;
+  Buffers buffers;
+  std::mt19937_64 rng;                   // warm-up configuration choices
+
+  // Hand-over buffers: `filling` is written by the acting thread while the
+  // learner consumes the other one.
+  std::vector<Transition> pending[2];
+  int filling = 0, filled = 0;
+  std::unique_ptr<LearnerWorker> worker;
+
+  int episode = 0, evaluations = 0;
+  std::int64_t steps = 0;
+  double wall_before = 0;  // wall time of earlier sessions (resume), s
+  Clock::time_point started = Clock::now();
+  std::vector<double> recent_success;  // last 20 training episodes
+
+  Impl(const CooptConfig& c, const std::string& dir, TrainerCallbacks cb)
+      : config(c), run_dir(dir), callbacks(std::move(cb)), env(c.env), scene(c), rng(c.trainer.seed * 7919ULL + 17) {
+    rl::set_torch_threads(c.trainer.torch_threads, 1);
+    const std::uint64_t seed = static_cast<std::uint64_t>(c.trainer.seed);
+    learner = make_motion(c, seed, false);
+    agent.motion = make_motion(c, seed + 1, true);
+    rl::copy_parameters(*networks_of(*agent.motion), *networks_of(*learner));
+    agent.config = make_config_model(c, seed + 2);
+    allocate_buffers(c, buffers);
+    for (auto& p : pending) {
+      p.resize(c.trainer.sync_interval);
+      for (auto& t : p) {
+        rl::allocate(motion_spec(c), t.obs);
+        rl::allocate(motion_spec(c), t.next);
+        t.action.continuous.assign(control::kActionSize, 0.0f);
+      }
+    }
+    worker = std::make_unique<LearnerWorker>(c.trainer.learner_thread);
+    scene.label_source = callbacks.label_source;
+  }
+
+  double wall() const { return wall_before + std::chrono::duration<double>(Clock::now() - started).count(); }
+
+  // Hands the filled transitions to the learner (after its previous job) and
+  // refreshes the acting copy's weights from the learner.
+  void hand_over() {
+    worker->wait();
+    rl::copy_parameters(*networks_of(*agent.motion), *networks_of(*learner));
+    if (filled == 0) return;
+    std::vector<Transition>* batch = &pending[filling];
+    const int n = filled;
+    filling = 1 - filling;
+    filled = 0;
+    rl::Learner* l = learner.get();
+    worker->submit([l, batch, n] {
+      for (int i = 0; i < n; ++i) {
+        const Transition& t = (*batch)[i];
+        l->store(t.obs, t.action, t.reward, t.next, t.terminated, t.truncated);
+        for (int u = l->updates_due(); u > 0; --u) l->update();
+      }
+    });
+  }
+
+  // Episode end: everything handed over and learnt, acting copy up to date.
+  void full_sync() {
+    hand_over();
+    worker->wait();
+    rl::copy_parameters(*networks_of(*agent.motion), *networks_of(*learner));
+  }
+
+  EpisodeLog train_episode() {
+    const TrainerParams& t = config.trainer;
+    const bool warmup = episode < t.warmup_episodes;
+    LearnHooks hooks;
+    hooks.motion = [this](const rl::Observation& o, const rl::Action& a, float r, const rl::Observation& n,
+                          bool term, bool trunc) {
+      agent.motion->store(o, a, r, n, term, trunc);  // keeps the acting copy's exploration counters
+      Transition& tr = pending[filling][filled++];
+      tr.obs.image = o.image;  // same sizes: copies, no allocation
+      tr.obs.vector = o.vector;
+      tr.next.image = n.image;
+      tr.next.vector = n.vector;
+      tr.action.continuous = a.continuous;
+      tr.reward = r;
+      tr.terminated = term;
+      tr.truncated = trunc;
+      ++steps;
+      if (filled == config.trainer.sync_interval) hand_over();
+    };
+    hooks.config = [this](const rl::Observation& o, const rl::Action& a, float r2, const rl::Observation& n,
+                          bool term, bool trunc, int k) {
+      agent.config->store(o, a, r2, n, term, trunc, k);
+      for (int u = agent.config->updates_due(); u > 0; --u) agent.config->update();
+      if (callbacks.on_decision) {
+        DecisionLog d;
+        d.episode = episode;
+        d.step = env.step_count();
+        d.modules = modules_of(a.discrete);
+        d.r2 = r2;
+        d.k = k;
+        for (int c = 0; c < kCandidates; ++c)
+          if (n.valid_actions[c]) d.next_max_modules = modules_of(c);
+        d.terminated = term;
+        d.truncated = trunc;
+        callbacks.on_decision(d);
+      }
+    };
+    if (warmup)
+      hooks.random_config = [this](const std::vector<std::uint8_t>& mask) {
+        int valid = 0;
+        for (auto m : mask) valid += m;
+        int k = std::uniform_int_distribution<int>(0, valid - 1)(rng);
+        for (int a = 0; a < static_cast<int>(mask.size()); ++a)
+          if (mask[a] && k-- == 0) return a;
+        return -1;
+      };
+    task::EpisodeSpec spec;
+    spec.seed = static_cast<std::uint64_t>(t.seed) * 1000003ULL + static_cast<std::uint64_t>(episode);
+    spec.stair_height = t.stair_height;
+    bool mixed = false;
+    scenario_settings(t.scenario, spec.obstacles, mixed);
+    spec.variant = mixed ? sim::Variant::mixed : sim::Variant::standard;
+    EpisodeLog log = play(config, agent, env, scene, spec, true, &hooks, buffers);
+    full_sync();
+    log.episode = episode;
+    log.warmup = warmup;
+    return log;
+  }
+
+  EvaluationLog periodic_evaluation() {
+    EvaluationLog e;
+    e.train_episode = episode;
+    e.env_steps = steps;
+    e.wall_s = wall();
+    for (int i = 0; i < config.trainer.eval_episodes; ++i) {
+      const auto spec = eval_spec(config, config.trainer.scenario,
+                                  static_cast<std::uint64_t>(config.trainer.eval_seed) + i, i);
+      EpisodeLog log = play(config, agent, env, scene, spec, false, nullptr, buffers);
+      log.episode = i;
+      e.episodes.push_back(std::move(log));
+    }
+    return e;
+  }
+
+  void progress(const EpisodeLog& log) {
+    recent_success.push_back(log.success ? 1.0 : 0.0);
+    if (recent_success.size() > 20) recent_success.erase(recent_success.begin());
+    const TrainerParams& t = config.trainer;
+    const int total = t.warmup_episodes + t.episodes;
+    if (episode % t.progress_interval != 0 && episode != total) return;
+    double rate = 0;
+    for (double s : recent_success) rate += s;
+    rate /= static_cast<double>(recent_success.size());
+    const double w = wall();
+    const double eta_s = episode > 0 ? w / episode * (total - episode) : 0;
+    std::string configs;
+    for (int m : log.configurations) configs += (configs.empty() ? "" : "->") + std::to_string(m);
+    std::fprintf(stderr,
+                 "episode %d/%d%s | %d steps, return %.1f, %s | total %lld steps, %.0f steps/s | success %.0f %% "
+                 "(last %zu) | config %s (stairs %.2f m) | wall %.0f s, ETA %.0f s\n",
+                 episode, total, log.warmup ? " (warm-up)" : "", log.steps, log.return_R1, log.termination.c_str(),
+                 static_cast<long long>(steps), w > 0 ? steps / w : 0.0, 100.0 * rate, recent_success.size(),
+                 configs.c_str(), log.stair_height_m, w, eta_s);
+  }
+
+  void save_checkpoint() {
+    full_sync();
+    const std::string dir = checkpoint_dir(run_dir);
+    const std::string tmp = dir + ".tmp", old = dir + ".old";
+    fs::remove_all(tmp);
+    fs::create_directories(tmp);
+    learner->save((fs::path(tmp) / "motion.pt").string());
+    agent.motion->save((fs::path(tmp) / "motion_actor.pt").string());
+    if (agent.config) agent.config->save((fs::path(tmp) / "config_model.pt").string());
+    YAML::Emitter e;
+    e << YAML::BeginMap;
+    e << YAML::Key << "episodes" << YAML::Value << episode;
+    e << YAML::Key << "evaluations" << YAML::Value << evaluations;
+    e << YAML::Key << "env_steps" << YAML::Value << steps;
+    e << YAML::Key << "wall_s" << YAML::Value << wall();
+    e << YAML::Key << "rng" << YAML::Value << rl::rng_state(rng);
+    e << YAML::Key << "config" << YAML::Value << YAML::Literal << config.text;
+    e << YAML::EndMap;
+    write_text_file((fs::path(tmp) / "trainer.yaml").string(), e.c_str());
+    // Swap directories: a crash at any point leaves either `checkpoint` or
+    // `checkpoint.old` complete (read_checkpoint_info falls back to .old).
+    fs::remove_all(old);
+    if (fs::exists(dir)) fs::rename(dir, old);
+    fs::rename(tmp, dir);
+    fs::remove_all(old);
+  }
+
+  void load_checkpoint() {
+    const CheckpointInfo info = read_checkpoint_info(run_dir);
+    if (info.config_text != config.text)
+      throw std::runtime_error(run_dir + ": the checkpoint was written by another configuration (" +
+                               first_difference(config.text, info.config_text) + "); refusing to resume");
+    learner->load((fs::path(info.directory) / "motion.pt").string());
+    agent.motion->load((fs::path(info.directory) / "motion_actor.pt").string());
+    if (agent.config) agent.config->load((fs::path(info.directory) / "config_model.pt").string());
+    const YAML::Node n = YAML::LoadFile((fs::path(info.directory) / "trainer.yaml").string());
+    rl::set_rng_state(rng, n["rng"].as<std::string>());
+    episode = info.episodes;
+    evaluations = info.evaluations;
+    steps = info.env_steps;
+    wall_before = info.wall_s;
+    started = Clock::now();
+    truncate_csv_rows((fs::path(run_dir) / "episodes.csv").string(), episode);
+    truncate_csv_rows((fs::path(run_dir) / "evaluations.csv").string(), evaluations);
+  }
+};
+
+Trainer::Trainer(const CooptConfig& config, const std::string& run_dir, TrainerCallbacks callbacks)
+    : impl_(std::make_unique<Impl>(config, run_dir, std::move(callbacks))) {}
+Trainer::~Trainer() = default;
+
+void Trainer::resume() { impl_->load_checkpoint(); }
+void Trainer::checkpoint() { impl_->save_checkpoint(); }
+int Trainer::episodes_done() const { return impl_->episode; }
+int Trainer::evaluations_done() const { return impl_->evaluations; }
+std::int64_t Trainer::env_steps() const { return impl_->steps; }
+double Trainer::wall_s() const { return impl_->wall(); }
+
+bool Trainer::run(const std::atomic<bool>* stop) {
+  Impl& m = *impl_;
+  const TrainerParams& t = m.config.trainer;
+  const int total = t.warmup_episodes + t.episodes;
+  while (m.episode < total) {
+    if (stop && stop->load()) {
+      m.save_checkpoint();
+      return false;
+    }
+    const EpisodeLog log = m.train_episode();
+    ++m.episode;
+    if (m.callbacks.on_episode) m.callbacks.on_episode(log);
+    m.progress(log);
+    const bool last = m.episode == total;
+    if (t.eval_interval > 0 && (m.episode % t.eval_interval == 0 || last)) {
+      const EvaluationLog e = m.periodic_evaluation();
+      ++m.evaluations;
+      if (m.callbacks.on_evaluation) m.callbacks.on_evaluation(e);
+    }
+    if (m.episode % t.checkpoint_interval == 0 || last) m.save_checkpoint();
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+
+std::vector<EpisodeLog> evaluate(const CooptConfig& config, const std::string& run_dir, const EvalRequest& request) {
+  const CheckpointInfo info = read_checkpoint_info(run_dir);
+  if (info.config_text != config.text)
+    throw std::runtime_error(run_dir + ": the checkpoint was written by another configuration (" +
+                             first_difference(config.text, info.config_text) + ")");
+  rl::set_torch_threads(1, 1);
+  std::vector<EpisodeLog> logs(static_cast<std::size_t>(request.episodes));
+  std::atomic<int> next{0};
+  std::mutex error_mutex;
+  std::exception_ptr error;
+  auto work = [&] {
+    try {
+      task::MultiTaskEnv env(config.env);
+      SceneSource scene(config);
+      Agent agent;
+      agent.motion = make_motion(config, 1, true);
+      agent.motion->load((fs::path(info.directory) / "motion_actor.pt").string());
+      agent.config = make_config_model(config, 2);
+      if (agent.config) agent.config->load((fs::path(info.directory) / "config_model.pt").string());
+      Buffers b;
+      allocate_buffers(config, b);
+      for (int i = next++; i < request.episodes; i = next++) {
+        const auto spec = eval_spec(config, request.scenario, static_cast<std::uint64_t>(request.seed) + i, i);
+        EpisodeLog log = play(config, agent, env, scene, spec, false, nullptr, b);
+        log.episode = i;
+        log.scenario = request.scenario;
+        logs[static_cast<std::size_t>(i)] = std::move(log);
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = std::current_exception();
+      next = request.episodes;
+    }
+  };
+  const int workers = std::max(1, std::min(request.workers, request.episodes));
+  std::vector<std::thread> threads;
+  for (int w = 1; w < workers; ++w) threads.emplace_back(work);
+  work();
+  for (auto& th : threads) th.join();
+  if (error) std::rethrow_exception(error);
+  return logs;
+}
+
+}  // namespace comorph::coopt

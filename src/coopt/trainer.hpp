@@ -1,0 +1,145 @@
+// The hierarchical co-optimization trainer (paper Fig. 2, Algorithms 1 and 2)
+// and the greedy evaluator. No torch in this header (pimpl): the CLI includes it.
+//
+// Per training episode:
+//  1. the configuration model (rl::Dqn over the 9 chains of 2..10 modules)
+//     sees the first depth image [+ C_n and the scene] and picks the chain;
+//     the env is reset with it (fixed mode: trainer.fixed_modules, no DQN);
+//  2. every control step the motion model (rl::Td3 or rl::Sac) acts on depth +
+//     state; the motion mode follows the current scene (stairs -> stair mode,
+//     else flat); R1 goes to the motion model's replay;
+//  3. the switch detector (perception::SwitchDetector on the simulator's
+//     labels, or SceneMonitor on the classifier's) declares scene switches; at
+//     each switch the segment so far becomes one semi-MDP transition for the
+//     DQN (reward R2 of Eq. 7, discount gamma^k, next mask [2, C_n]) and the
+//     DQN decides again among [2, C_n] (env.reconfigure sheds tail modules);
+//  4. at the episode end the last segment is stored (terminated/truncated).
+//
+// Both cores: the motion learner (full replay, optimizers) lives on a learner
+// thread; the acting thread runs the simulation with a copy of the actor (a
+// second learner object with a one-slot replay that keeps the exploration
+// counters). Every trainer.sync_interval control steps and at every episode
+// end the acting thread hands over its transitions, waits for the learner's
+// previous batch of updates and copies the new weights. The schedule is a
+// function of the step count only, so the threaded and the inline mode give
+// the same results for a seed (docs/coopt.md has the trade-off: the acting
+// policy lags the learner by one to two intervals).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "coopt/config.hpp"
+
+namespace comorph::coopt {
+
+// One finished episode (training or evaluation). Mirrors report::EpisodeRecord
+// (the CLI converts), plus trainer diagnostics.
+struct EpisodeLog {
+  int episode = 0;                  // index within its run (training) or evaluation
+  std::uint64_t seed = 0;           // scene seed
+  std::string scenario;             // default | obstacles7 | obstacles8 | mixed
+  double stair_height_m = 0;        // m
+  int obstacles = 0;                // K in the flat area
+  bool success = false;             // reached the target
+  std::string termination;          // task::termination_name of the ending reason
+  double time_s = 0;                // simulated s
+  double energy_J = 0;              // J drawn by all modules
+  double distance_fraction = 0;     // D of Eq. 1, 0..1
+  double return_R1 = 0;             // summed R1 (Eq. 6)
+  double return_R2 = 0;             // summed R2 over the DQN's segments (Eq. 7); 0 in fixed mode
+  double F = 0;                     // F(H) with the task's objective weights
+  std::vector<int> configurations;  // modules after each decision, consecutive repeats collapsed ("6->2")
+  int modules_total = 0;            // modules at the start
+  int steps = 0;                    // control steps
+  int switches = 0;                 // scene switches declared by the detector
+  double stairs_energy_J = 0;       // E_c: J drawn while on the stairs (the R2 cost)
+  bool warmup = false;              // random-action warm-up episode
+};
+
+// One periodic evaluation (a row of evaluations.csv).
+struct EvaluationLog {
+  int train_episode = 0;            // training episodes done when it ran
+  std::int64_t env_steps = 0;       // training control steps done
+  double wall_s = 0;                // training wall time, s
+  std::vector<EpisodeLog> episodes; // the greedy episodes
+};
+
+// One semi-MDP transition of the configuration model (training only).
+struct DecisionLog {
+  int episode = 0;           // training episode
+  int step = 0;              // control step of the episode at which the segment ended
+  int modules = 0;           // modules chosen for the segment that just ended
+  double r2 = 0;             // reward R2 (Eq. 7) of the segment
+  int k = 0;                 // control steps of the segment (discount gamma^k)
+  int next_max_modules = 0;  // the next state's mask allows [2, this]
+  bool terminated = false;   // the episode ended in a terminal state in this segment
+  bool truncated = false;    // the episode hit the step cap in this segment
+};
+
+struct TrainerCallbacks {
+  std::function<void(const EpisodeLog&)> on_episode;        // after every training episode
+  std::function<void(const EvaluationLog&)> on_evaluation;  // after every periodic evaluation
+  std::function<void(const DecisionLog&)> on_decision;      // after every stored DQN transition
+  // Optional custom labeller for scene_source: ground_truth (tests, other
+  // label sources): (control step of the episode, ground-truth label) -> label
+  // fed to the switch detector.
+  std::function<int(int, int)> label_source;
+};
+
+// What a checkpoint says about its run (run_dir/checkpoint/trainer.yaml).
+struct CheckpointInfo {
+  int episodes = 0;             // training episodes done (= rows of episodes.csv)
+  int evaluations = 0;          // periodic evaluations done (= rows of evaluations.csv)
+  std::int64_t env_steps = 0;   // training control steps done
+  double wall_s = 0;            // training wall time so far, s
+  std::string config_text;      // the merged config the run was started with
+  std::string directory;        // where it was read from
+};
+// Reads the latest complete checkpoint of a run (throws when there is none).
+CheckpointInfo read_checkpoint_info(const std::string& run_dir);
+// Keeps the header and the first `rows` data rows of a CSV file (resume after a kill).
+void truncate_csv_rows(const std::string& path, int rows);
+
+class Trainer {
+ public:
+  // run_dir must exist; checkpoints go to run_dir/checkpoint, evaluations.csv is written there.
+  Trainer(const CooptConfig& config, const std::string& run_dir, TrainerCallbacks callbacks = {});
+  ~Trainer();
+  // Loads run_dir's latest checkpoint; throws (naming the difference) when it
+  // was written by another configuration. Truncates episodes.csv and
+  // evaluations.csv to the rows the checkpoint counted.
+  void resume();
+  // Trains until every episode is done (returns true) or *stop becomes true
+  // (the current episode is finished and checkpointed; returns false).
+  bool run(const std::atomic<bool>* stop = nullptr);
+  // Writes a checkpoint now (between episodes).
+  void checkpoint();
+
+  int episodes_done() const;
+  int evaluations_done() const;
+  std::int64_t env_steps() const;
+  double wall_s() const;  // training wall time including resumed parts
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// `comorph eval`: greedy episodes of a trained run on the paper's protocol.
+struct EvalRequest {
+  std::string scenario = "default";  // default | obstacles7 | obstacles8 | mixed
+  int episodes = 30;                 // stair height of episode i = heights[i % 3]
+  int seed = 700000;                 // seed of episode i = seed + i
+  int workers = 2;                   // threads (each its own env and network copies)
+};
+// Loads run_dir/checkpoint; results are ordered by episode and do not depend on `workers`.
+std::vector<EpisodeLog> evaluate(const CooptConfig& config, const std::string& run_dir,
+                                 const EvalRequest& request);
+
+}  // namespace comorph::coopt

@@ -1,0 +1,328 @@
+// Short runs of the ci preset: the hierarchy end to end, scene switches and the
+// configuration model's semi-MDP transitions, checkpoints and resume (same
+// results as an uninterrupted run), thread-independence, baselines, the
+// evaluator, the CLI's bad-input handling, and a learning test.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "coopt/config.hpp"
+#include "coopt/segment.hpp"
+#include "coopt/trainer.hpp"
+#include "perception/params.hpp"
+
+namespace comorph::coopt {
+namespace {
+namespace fs = std::filesystem;
+
+const std::string kCi = std::string(COMORPH_SOURCE_DIR) + "/configs/ci.yaml";
+
+std::string temp_dir(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("comorph_coopt_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p.string();
+}
+
+// A log line with every field that a change of behaviour would move.
+std::string line_of(const EpisodeLog& l) {
+  std::ostringstream s;
+  s.precision(17);
+  s << l.episode << ' ' << l.seed << ' ' << l.stair_height_m << ' ' << l.success << ' ' << l.termination << ' '
+    << l.time_s << ' ' << l.energy_J << ' ' << l.distance_fraction << ' ' << l.return_R1 << ' ' << l.return_R2
+    << ' ' << l.steps << ' ' << l.switches << ' ';
+  for (int m : l.configurations) s << m << ';';
+  return s.str();
+}
+
+struct RunResult {
+  std::vector<std::string> episodes;
+  std::vector<EpisodeLog> logs;
+  std::vector<DecisionLog> decisions;
+  int evaluations = 0;
+};
+
+TrainerCallbacks collecting(RunResult& r, const std::string& csv = "") {
+  TrainerCallbacks cb;
+  cb.on_episode = [&r, csv](const EpisodeLog& l) {
+    r.episodes.push_back(line_of(l));
+    r.logs.push_back(l);
+    if (!csv.empty()) std::ofstream(csv, std::ios::app) << line_of(l) << "\n";
+  };
+  cb.on_evaluation = [&r](const EvaluationLog& e) { r.evaluations += 1; };
+  cb.on_decision = [&r](const DecisionLog& d) { r.decisions.push_back(d); };
+  return cb;
+}
+
+RunResult run_ci(const std::vector<std::string>& sets, const std::string& dir) {
+  RunResult r;
+  Trainer t(load_coopt_config(kCi, sets), dir, collecting(r));
+  EXPECT_TRUE(t.run());
+  return r;
+}
+
+TEST(Trainer, CiPresetCompletesAndWritesALoadableCheckpoint) {
+  const std::string dir = temp_dir("ci");
+  const CooptConfig c = load_coopt_config(kCi);
+  RunResult r;
+  {
+    Trainer t(c, dir, collecting(r));
+    ASSERT_TRUE(t.run());
+    EXPECT_EQ(t.episodes_done(), c.trainer.warmup_episodes + c.trainer.episodes);
+    EXPECT_GT(t.env_steps(), 0);
+  }
+  ASSERT_EQ(r.logs.size(), static_cast<std::size_t>(c.trainer.warmup_episodes + c.trainer.episodes));
+  // eval_interval 3 over 6 episodes: after 3 and after 6.
+  EXPECT_EQ(r.evaluations, 2);
+  for (const auto& l : r.logs) {
+    EXPECT_GE(l.modules_total, kMinModules);
+    EXPECT_LE(l.modules_total, kMaxModules);
+    EXPECT_GT(l.steps, 0);
+    EXPECT_LE(l.steps, c.env.task.max_steps);
+    EXPECT_FALSE(l.termination.empty());
+  }
+  EXPECT_TRUE(r.logs[0].warmup);
+  EXPECT_FALSE(r.logs.back().warmup);
+  const CheckpointInfo info = read_checkpoint_info(dir);
+  EXPECT_EQ(info.episodes, 6);
+  EXPECT_EQ(info.evaluations, 2);
+  EXPECT_EQ(info.config_text, c.text);
+  for (const char* f : {"motion.pt", "motion_actor.pt", "config_model.pt", "trainer.yaml"})
+    EXPECT_TRUE(fs::exists(fs::path(dir) / "checkpoint" / f)) << f;
+  // Loadable: a new trainer restores it and has nothing left to do.
+  Trainer again(c, dir);
+  again.resume();
+  EXPECT_EQ(again.episodes_done(), 6);
+  EXPECT_EQ(again.env_steps(), info.env_steps);
+  EXPECT_TRUE(again.run());
+  EXPECT_EQ(again.episodes_done(), 6);
+  fs::remove_all(dir);
+}
+
+TEST(Trainer, ResultsDoNotDependOnTheLearnerThread) {
+  const std::string a = temp_dir("thr_a"), b = temp_dir("thr_b");
+  const RunResult threaded = run_ci({"trainer.learner_thread=true"}, a);
+  const RunResult inline_ = run_ci({"trainer.learner_thread=false"}, b);
+  EXPECT_EQ(threaded.episodes, inline_.episodes);
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
+TEST(Trainer, ResumeAfterInterruptionContinuesTheSameEpisodesWithIdenticalResults) {
+  const std::vector<std::string> sets{"trainer.episodes=6", "trainer.checkpoint_interval=3"};
+  const std::string full_dir = temp_dir("full");
+  const RunResult full = run_ci(sets, full_dir);
+  ASSERT_EQ(full.episodes.size(), 8u);
+
+  // Ctrl-C during episode 3 (index 2): it is finished and checkpointed.
+  const std::string dir = temp_dir("resume");
+  std::ofstream(dir + "/episodes.csv") << "header\n";
+  const CooptConfig c = load_coopt_config(kCi, sets);
+  std::atomic<bool> stop{false};
+  RunResult part;
+  {
+    TrainerCallbacks cb = collecting(part, dir + "/episodes.csv");
+    auto inner = cb.on_episode;
+    cb.on_episode = [&, inner](const EpisodeLog& l) {
+      inner(l);
+      if (l.episode == 4) stop = true;
+    };
+    Trainer t(c, dir, cb);
+    EXPECT_FALSE(t.run(&stop));
+    EXPECT_EQ(t.episodes_done(), 5);
+  }
+  // kill -9 after episode 7 was logged but before its checkpoint (every 3):
+  // the CSV has a row the checkpoint does not count.
+  {
+    TrainerCallbacks cb = collecting(part, dir + "/episodes.csv");
+    auto inner = cb.on_episode;
+    cb.on_episode = [inner](const EpisodeLog& l) {
+      inner(l);
+      if (l.episode == 6) throw std::runtime_error("killed");
+    };
+    Trainer t(c, dir, cb);
+    t.resume();
+    EXPECT_EQ(t.episodes_done(), 5);
+    EXPECT_THROW(t.run(), std::runtime_error);
+  }
+  EXPECT_EQ(read_checkpoint_info(dir).episodes, 6);
+  RunResult rest;
+  {
+    Trainer t(c, dir, collecting(rest, dir + "/episodes.csv"));
+    t.resume();  // truncates episodes.csv to the 6 rows the checkpoint counted
+    EXPECT_EQ(t.episodes_done(), 6);
+    EXPECT_TRUE(t.run());
+    EXPECT_EQ(t.episodes_done(), 8);
+  }
+  std::ifstream in(dir + "/episodes.csv");
+  std::vector<std::string> rows;
+  std::string header, line;
+  std::getline(in, header);
+  EXPECT_EQ(header, "header");
+  while (std::getline(in, line)) rows.push_back(line);
+  // No lost and no duplicated episode; identical to the uninterrupted run.
+  ASSERT_EQ(rows.size(), 8u);
+  EXPECT_EQ(rows, full.episodes);
+  fs::remove_all(full_dir);
+  fs::remove_all(dir);
+}
+
+TEST(Trainer, ACheckpointFromAnotherConfigurationIsRefused) {
+  const std::string dir = temp_dir("other");
+  run_ci({"trainer.episodes=0"}, dir);
+  Trainer t(load_coopt_config(kCi, {"trainer.episodes=0", "td3.batch_size=16"}), dir);
+  try {
+    t.resume();
+    ADD_FAILURE() << "resumed a checkpoint of another configuration";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("another configuration"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("batch_size"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+// Synthetic labels: stairs for the first 30 steps, then the obstacle field.
+// The detector (every 20 steps, window 10, > 70 %) must declare one switch at
+// step 40; the DQN then stores the stair segment (k = 40, next mask [2, C_n])
+// and decides again within the mask; the last segment ends the episode.
+TEST(Trainer, SceneSwitchEndsTheSegmentAndMasksTheNextChoice) {
+  const std::string dir = temp_dir("switch");
+  const CooptConfig c = load_coopt_config(kCi, {"trainer.episodes=4"});
+  RunResult r;
+  TrainerCallbacks cb = collecting(r);
+  cb.label_source = [](int step, int) { return step < 30 ? perception::kStairs : perception::kObstacleField; };
+  Trainer t(c, dir, cb);
+  ASSERT_TRUE(t.run());
+  ASSERT_EQ(r.logs.size(), 6u);
+  std::size_t d = 0;
+  for (const auto& l : r.logs) {
+    std::vector<DecisionLog> mine;
+    while (d < r.decisions.size() && r.decisions[d].episode == l.episode) mine.push_back(r.decisions[d++]);
+    if (l.steps < 40) {  // ended before the switch
+      EXPECT_EQ(l.switches, 0);
+      continue;
+    }
+    EXPECT_EQ(l.switches, 1) << "episode " << l.episode;
+    ASSERT_EQ(mine.size(), 2u) << "episode " << l.episode;
+    EXPECT_EQ(mine[0].step, 40);
+    EXPECT_EQ(mine[0].k, 40);
+    EXPECT_EQ(mine[0].modules, l.modules_total);
+    EXPECT_EQ(mine[0].next_max_modules, l.modules_total);  // only shedding from here
+    EXPECT_FALSE(mine[0].terminated || mine[0].truncated);
+    EXPECT_LE(mine[1].modules, mine[0].modules);
+    EXPECT_EQ(mine[1].k, l.steps - 40);
+    EXPECT_TRUE(mine[1].terminated || mine[1].truncated);
+    EXPECT_EQ(mine[1].modules, l.configurations.back());
+    // R2 over both segments: all of R1, minus sigma3 * E_c (not climbed: no r_s).
+    const double sigma3 = c.env.task.r2.sigma3;
+    if (l.termination != "success")
+      EXPECT_NEAR(mine[0].r2 + mine[1].r2, l.return_R1 - sigma3 * l.stairs_energy_J, 1e-3 * (1 + std::abs(l.return_R1)));
+  }
+  EXPECT_EQ(d, r.decisions.size());
+  fs::remove_all(dir);
+}
+
+TEST(Trainer, FixedBaselineAndSacRun) {
+  const std::string a = temp_dir("fixed"), b = temp_dir("sac");
+  const RunResult fixed = run_ci({"trainer.mode=fixed", "trainer.fixed_modules=6"}, a);
+  for (const auto& l : fixed.logs) {
+    EXPECT_EQ(l.configurations, std::vector<int>{6});
+    EXPECT_EQ(l.modules_total, 6);
+  }
+  EXPECT_TRUE(fixed.decisions.empty());
+  EXPECT_FALSE(fs::exists(fs::path(a) / "checkpoint" / "config_model.pt"));
+  const RunResult sac = run_ci({"trainer.motion_algo=sac"}, b);
+  EXPECT_EQ(sac.logs.size(), 6u);
+  EXPECT_FALSE(sac.decisions.empty());
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
+TEST(Evaluate, GreedyEpisodesCycleHeightsAndDoNotDependOnWorkers) {
+  const std::string dir = temp_dir("eval");
+  const CooptConfig c = load_coopt_config(kCi, {"trainer.episodes=1"});
+  run_ci({"trainer.episodes=1"}, dir);
+  EvalRequest req;
+  req.episodes = 5;
+  req.seed = 123;
+  req.workers = 1;
+  const auto one = evaluate(c, dir, req);
+  req.workers = 2;
+  const auto two = evaluate(c, dir, req);
+  ASSERT_EQ(one.size(), 5u);
+  ASSERT_EQ(two.size(), 5u);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(line_of(one[i]), line_of(two[i]));
+    EXPECT_EQ(one[i].seed, 123u + i);
+    EXPECT_NEAR(one[i].stair_height_m, (i % 3 == 0 ? 0.04 : i % 3 == 1 ? 0.06 : 0.08), 1e-9);
+  }
+  req.scenario = "obstacles8";
+  EXPECT_EQ(evaluate(c, dir, req)[0].obstacles, 8);
+  fs::remove_all(dir);
+}
+
+// ---- the CLI: bad input stops before a run directory exists ----
+
+int run_cli(const std::string& args, std::string& err) {
+  const std::string log = fs::temp_directory_path() / ("comorph_cli_" + std::to_string(::getpid()) + ".log");
+  const int status = std::system((std::string(COMORPH_EXE) + " " + args + " > " + log + " 2>&1").c_str());
+  std::ifstream in(log);
+  std::ostringstream s;
+  s << in.rdbuf();
+  err = s.str();
+  fs::remove(log);
+  return status;
+}
+
+TEST(Cli, BadConfigOrSetFailsWithTheKeyAndCreatesNoRunDirectory) {
+  const std::string parent = temp_dir("cli");
+  const std::string out = parent + "/run";
+  std::string err;
+  EXPECT_NE(run_cli("train --config " + kCi + " --set trainer.epsiodes=3 --out " + out, err), 0);
+  EXPECT_NE(err.find("trainer.epsiodes"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_NE(run_cli("train --config " + kCi + " --set dqn.epsilon_start=x --out " + out, err), 0);
+  EXPECT_NE(err.find("epsilon_start"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_NE(run_cli("train --config " + kCi + " --set trainer.warmup_episodes=-1 --out " + out, err), 0);
+  EXPECT_NE(err.find("warmup_episodes"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_NE(run_cli("train --config " + parent + "/missing.yaml --out " + out, err), 0);
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_NE(run_cli("train --resume " + out, err), 0);
+  EXPECT_FALSE(fs::exists(out));
+  fs::remove_all(parent);
+}
+
+TEST(Cli, TrainThenEvalWritesTheRunDirectoryLayout) {
+  const std::string parent = temp_dir("cli_ok");
+  const std::string out = parent + "/run";
+  std::string log;
+  ASSERT_EQ(run_cli("train --config " + kCi + " --set trainer.episodes=1 --out " + out, log), 0) << log;
+  for (const char* f : {"run.yaml", "config.yaml", "episodes.csv", "evaluations.csv", "checkpoint/trainer.yaml"})
+    EXPECT_TRUE(fs::exists(fs::path(out) / f)) << f;
+  std::ifstream csv(out + "/episodes.csv");
+  int lines = 0;
+  for (std::string l; std::getline(csv, l);) ++lines;
+  EXPECT_EQ(lines, 1 + 3);  // header + 2 warm-up + 1 episode
+  EXPECT_NE(run_cli("train --config " + kCi + " --out " + out, log), 0);  // exists: use --resume
+  ASSERT_EQ(run_cli("eval --run " + out + " --episodes 3 --scenario obstacles7", log), 0) << log;
+  EXPECT_TRUE(fs::exists(fs::path(out) / "eval-obstacles7.json"));
+  EXPECT_TRUE(fs::exists(fs::path(out) / "eval-obstacles7-episodes.csv"));
+  std::ifstream json(out + "/eval-obstacles7.json");
+  std::ostringstream s;
+  s << json.rdbuf();
+  for (const char* key : {"success_rate", "\"0.04\"", "\"avg\"", "time_s", "energy_J", "configurations", "terminations"})
+    EXPECT_NE(s.str().find(key), std::string::npos) << key;
+  fs::remove_all(parent);
+}
+
+}  // namespace
+}  // namespace comorph::coopt

@@ -1,0 +1,117 @@
+// Candidate masks, R2 over a segment, and the run config (keys, ranges, --set).
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "coopt/config.hpp"
+#include "coopt/segment.hpp"
+#include "task/rewards.hpp"
+
+namespace comorph::coopt {
+namespace {
+
+const std::string kCi = std::string(COMORPH_SOURCE_DIR) + "/configs/ci.yaml";
+
+TEST(CandidateMask, FirstChoiceAllowsEveryChainThenOnlyFewerModules) {
+  const auto all = candidate_mask(kMaxModules);
+  ASSERT_EQ(all.size(), static_cast<std::size_t>(kCandidates));
+  for (int c = 0; c < kCandidates; ++c) EXPECT_EQ(all[c], 1) << "candidate " << c;
+  const auto after6 = candidate_mask(6);
+  for (int c = 0; c < kCandidates; ++c) EXPECT_EQ(after6[c], modules_of(c) <= 6 ? 1 : 0) << modules_of(c);
+  const auto after2 = candidate_mask(2);
+  EXPECT_EQ(after2[candidate_of(2)], 1);
+  for (int m = 3; m <= kMaxModules; ++m) EXPECT_EQ(after2[candidate_of(m)], 0) << m;
+  EXPECT_THROW(candidate_mask(1), std::invalid_argument);
+  EXPECT_THROW(candidate_mask(11), std::invalid_argument);
+}
+
+TEST(Segment, StairSegmentAccumulatesR1AndPaysClimbMinusStairEnergy) {
+  task::R2Params p;  // sigma1 1, s_base 0.04, r_s 60, sigma3 0.003
+  Segment s;
+  s.begin(/*stairs_climbed=*/false, /*E_c so far=*/5.0);
+  const double r1[] = {0.5, -0.25, 1.0, 2.0};
+  double sum = 0;
+  for (int i = 0; i < 4; ++i) {
+    s.add_step(r1[i], i == 2);
+    sum += r1[i];
+  }
+  EXPECT_EQ(s.steps(), 4);
+  EXPECT_DOUBLE_EQ(s.sum_r1(), sum);
+  EXPECT_TRUE(s.climbed());
+  // Stair energy counted from the decision on: 125 J - 5 J = 120 J.
+  const double expected = sum + (1.0 + 0.08 / 0.04) * 60.0 - 0.003 * 120.0;
+  EXPECT_NEAR(s.r2(p, 0.08, 125.0), expected, 1e-12);
+  // Not climbed: no r_s, the energy still costs.
+  Segment t;
+  t.begin(false, 0.0);
+  t.add_step(1.0, false);
+  EXPECT_NEAR(t.r2(p, 0.06, 100.0), 1.0 - 0.3, 1e-12);
+}
+
+TEST(Segment, AfterTheStairsOnlyTheSummedR1Counts) {
+  task::R2Params p;
+  Segment s;
+  s.begin(/*stairs_climbed=*/true, 300.0);
+  for (int i = 0; i < 10; ++i) s.add_step(0.1, false);
+  EXPECT_EQ(s.steps(), 10);
+  EXPECT_FALSE(s.stairs_segment());
+  EXPECT_NEAR(s.r2(p, 0.08, 900.0), 1.0, 1e-12);
+  s.begin(true, 0.0);  // a new segment starts from zero
+  EXPECT_EQ(s.steps(), 0);
+  EXPECT_EQ(s.sum_r1(), 0.0);
+}
+
+TEST(CooptConfig, CiPresetLoadsAndSetOverridesNestedKeys) {
+  const CooptConfig c = load_coopt_config(kCi, {"trainer.episodes=7", "env.task.max_steps=99", "td3.hidden_sizes=[8, 8]",
+                                                "perception.switch_detector.interval=30"});
+  EXPECT_EQ(c.trainer.episodes, 7);
+  EXPECT_EQ(c.env.task.max_steps, 99);
+  EXPECT_EQ(c.perception.switch_detector.interval, 30);
+  EXPECT_NE(c.td3_yaml.find("8"), std::string::npos);
+  EXPECT_NE(c.text.find("episodes: 7"), std::string::npos);
+  EXPECT_EQ(c.preset, "ci");
+  // The merged text reloads to the same config (what resume relies on).
+  EXPECT_EQ(coopt_config_from_text(c.text, "copy").text, c.text);
+}
+
+void expect_error(const std::vector<std::string>& sets, const std::string& needle) {
+  try {
+    load_coopt_config(kCi, sets);
+    ADD_FAILURE() << "no error for " << sets.front();
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+TEST(CooptConfig, UnknownKeysAndOutOfRangeValuesNameTheKey) {
+  expect_error({"trainer.episodez=3"}, "trainer.episodez");
+  expect_error({"trainer.fixed_modules=11"}, "trainer.fixed_modules");
+  expect_error({"trainer.sync_interval=0"}, "trainer.sync_interval");
+  expect_error({"trainer.motion_algo=ppo"}, "trainer.motion_algo");
+  expect_error({"trainer.scene_source=classifier"}, "trainer.classifier_dir");
+  expect_error({"trainer.scene_source=classifier", "trainer.classifier_dir=/nonexistent"}, "classifier.pt");
+  expect_error({"td3.learning_rat=1"}, "learning_rat");
+  expect_error({"dqn.batch_size=abc"}, "batch_size");
+  expect_error({"env.task.max_steps=0"}, "max_steps");
+  expect_error({"env.robot.wheel_radiuss=1"}, "wheel_radiuss");
+  expect_error({"perception.switch_detector.agreement=1.5"}, "agreement");
+  expect_error({"td3.random_action_episodes=5"}, "warmup_episodes");
+  expect_error({"nosection.x=1"}, "nosection");
+  expect_error({"trainer.episodes"}, "key=value");
+}
+
+TEST(Scenario, NamesMapToObstaclesAndVariant) {
+  int k = 0;
+  bool mixed = true;
+  scenario_settings("default", k, mixed);
+  EXPECT_EQ(k, -1);
+  EXPECT_FALSE(mixed);
+  scenario_settings("obstacles8", k, mixed);
+  EXPECT_EQ(k, 8);
+  scenario_settings("mixed", k, mixed);
+  EXPECT_TRUE(mixed);
+  EXPECT_THROW(scenario_settings("stairs9", k, mixed), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace comorph::coopt
