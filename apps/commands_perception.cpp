@@ -3,7 +3,7 @@
 //
 //   comorph classifier train --data FILE [--eval-data FILE] --out DIR
 //                            [--config configs/perception.yaml] [--epochs E] [--seed S]
-//   comorph classifier eval --model DIR --data FILE
+//   comorph classifier eval --model DIR --data FILE [--config FILE] [--switch-trials N] [--seed S]
 //   comorph classifier synthetic --out FILE [--count N] [--seed S]
 //
 // Extending: the simulation side adds `comorph classifier dataset ...` (depth
@@ -22,6 +22,7 @@
 #include "perception/dataset.hpp"
 #include "perception/perception_config.hpp"
 #include "perception/scene_classifier.hpp"
+#include "perception/switch_evaluation.hpp"
 #include "perception/synthetic.hpp"
 #include "perception/training.hpp"
 
@@ -88,13 +89,32 @@ void run_train(const TrainOptions& o) {
             << (fs::path(o.out) / "classifier.yaml").string() << "\n";
 }
 
-void run_eval(const std::string& model_dir, const std::string& data_path) {
+struct EvalOptions {
+  std::string model, data, config;
+  int switch_trials = 100;
+  std::uint64_t seed = 1;
+};
+
+void run_eval(const EvalOptions& o) {
+  perception::PerceptionConfig cfg;
+  if (!o.config.empty()) cfg = perception::load_perception_config(o.config);
   perception::SceneClassifier::set_threads(1);
-  perception::SceneClassifier model = perception::SceneClassifier::load(model_dir);
-  const perception::Dataset data = perception::load_dataset(data_path);
-  std::cout << data_path << ": " << describe(data, model.params()) << "\n";
+  perception::SceneClassifier model = perception::SceneClassifier::load(o.model);
+  const perception::Dataset data = perception::load_dataset(o.data);
+  std::cout << o.data << ": " << describe(data, model.params()) << "\n";
   const perception::EvalResult r = perception::evaluate_classifier(model, data);
   std::cout << perception::format_evaluation(r, model.params());
+  if (o.switch_trials > 0) {
+    perception::SwitchTrialParams t;
+    t.trials = o.switch_trials;
+    t.seed = o.seed;
+    const auto& d = cfg.switch_detector;
+    std::cout << fmt::format(
+        "switch trials: {} episodes of {} control steps, one scene change each in [{}, {}), frames drawn "
+        "from the file; detector every {} steps, last {} frames, > {:.0f} % agree\n",
+        t.trials, t.steps, t.earliest_change, t.latest_change, d.interval, d.window, 100 * d.agreement);
+    std::cout << perception::format_switch_report(perception::evaluate_switching(model, data, d, t));
+  }
 }
 
 void add_classifier_subcommands(CLI::App& app) {
@@ -114,10 +134,15 @@ void add_classifier_subcommands(CLI::App& app) {
   train->callback([] { run_train(to); });
 
   auto* eval = cls->add_subcommand("eval", "print accuracy and the confusion matrix of a saved classifier");
-  static std::string model_dir, eval_data;
-  eval->add_option("--model", model_dir, "directory written by `classifier train`")->required();
-  eval->add_option("--data", eval_data, "dataset file")->required();
-  eval->callback([] { run_eval(model_dir, eval_data); });
+  static EvalOptions eo;
+  eval->add_option("--model", eo.model, "directory written by `classifier train`")->required();
+  eval->add_option("--data", eo.data, "dataset file")->required();
+  eval->add_option("--config", eo.config, "perception preset for the switch detector (default: built-in)");
+  eval->add_option("--switch-trials", eo.switch_trials,
+                   "episodes with one scene change to measure the switch delay on (0 = skip)")
+      ->check(CLI::NonNegativeNumber);
+  eval->add_option("--seed", eo.seed, "seed of the switch trials");
+  eval->callback([] { run_eval(eo); });
 
   auto* synth = cls->add_subcommand(
       "synthetic", "write a synthetic 3-class depth dataset (stairs / obstacles / open) for trials");

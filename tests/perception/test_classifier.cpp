@@ -17,6 +17,7 @@
 
 #include "perception/scene_classifier.hpp"
 #include "perception/scene_monitor.hpp"
+#include "perception/switch_evaluation.hpp"
 #include "perception/synthetic.hpp"
 #include "perception/training.hpp"
 
@@ -233,4 +234,20 @@ TEST(Classifier, RejectsDataThatDoesNotFit) {
   cp::ClassifierParams bad = small_net();
   bad.device = "toaster";
   EXPECT_THROW(cp::SceneClassifier{bad}, std::invalid_argument);
+}
+
+TEST_F(TrainedClassifier, SwitchTrialsDetectTheChangesWithinTwoIntervals) {
+  cp::SwitchTrialParams t;
+  t.trials = 20;
+  t.seed = 5;
+  const cp::SwitchTrialReport r = cp::evaluate_switching(result_->model, *held_out_, {100, 10, 0.7}, t);
+  EXPECT_EQ(r.trials, 20);
+  EXPECT_EQ(r.delays.detected + r.delays.missed, 20);
+  EXPECT_GE(r.delays.detected, 18);
+  EXPECT_LE(r.delays.false_switches, 2);
+  // A change is seen at the next decision (< 100 steps) or, when the window
+  // straddles it, the one after (< 200 steps).
+  EXPECT_GE(r.delays.mean_delay(), 0.0);
+  EXPECT_LT(r.max_delay, 200.0);
+  std::cout << cp::format_switch_report(r);
 }
