@@ -28,6 +28,7 @@ struct SimOptions {
   bool json = false;
   int seeds = 3;
   bool quick = false;
+  int shed_to = 0;
 };
 
 task::EnvConfig load_config(const std::string& dir) { return task::load_env_config(dir); }
@@ -121,9 +122,16 @@ void run_demo(const SimOptions& o) {
       std::cout << fmt::format("  t={:6.2f} s  event: mode {} -> {}\n", t, control::mode_name(last_mode),
                                control::mode_name(mode));
     last_mode = mode;
-    if (r.stairs_climbed_now)
+    if (r.stairs_climbed_now) {
       std::cout << fmt::format("  t={:6.2f} s  event: stairs climbed (energy on stairs {:.1f} J)\n", t,
                                env.stairs_energy());
+      if (o.shed_to >= 2 && o.shed_to < env.modules() && !env.done()) {
+        const int before = env.modules();
+        env.reconfigure(o.shed_to);
+        std::cout << fmt::format("  t={:6.2f} s  event: reconfigured {} -> {} modules (tail shed)\n", t, before,
+                                 env.modules());
+      }
+    }
     if (r.scene_label != last_label)
       std::cout << fmt::format("  t={:6.2f} s  event: scene label {} -> {}\n", t, last_label, r.scene_label);
     last_label = r.scene_label;
@@ -131,9 +139,9 @@ void run_demo(const SimOptions& o) {
       const task::Metrics m = env.metrics();
       std::cout << fmt::format(
           "  t={:6.2f} s  step {:4d}  pos ({:5.2f}, {:5.2f}, {:4.2f}) m  to target {:5.2f} m  energy {:7.1f} J "
-          "({:4.1f} W/module)  R1 sum {:8.1f}\n",
+          "({:4.1f} W per initial module)  R1 sum {:8.1f}\n",
           t, env.step_count(), head[0], head[1], head[2], m.initial_distance_m - m.distance_done_m, m.energy_J,
-          m.energy_J / std::max(t, 1e-9) / env.modules(), reward_sum);
+          m.energy_J / std::max(t, 1e-9) / env.initial_modules(), reward_sum);
     }
     if (env.done()) {
       const task::Metrics m = env.metrics();
@@ -173,6 +181,7 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   demo->add_option("--stair-height", o.stair_height, "m, step height (0 = drawn from the seed)");
   demo->add_option("--obstacles", o.obstacles, "K obstacles (-1 = scene default)");
   demo->add_option("--variant", o.variant, "standard | mixed");
+  demo->add_option("--shed-to", o.shed_to, "after the stairs, shed tail modules down to this many (0 = keep)");
   demo->add_option("--config-dir", o.config_dir, "directory of robot/scene/motion/task.yaml");
   demo->callback([] { run_demo(o); });
 }};

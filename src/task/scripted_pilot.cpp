@@ -64,10 +64,27 @@ void ScriptedPilot::act(const MultiTaskEnv& env, float a[control::kActionSize],
   mode = env.default_mode();
   double gx, gy;
   env.goal(gx, gy);
-  if (env.stairs_climbed() && !field_.empty()) {
+  const bool climbing = !env.stairs_climbed();
+  // Steer along the planned path once module 1 is on the flat area (a long
+  // chain's head reaches the obstacles while its tail is still climbing).
+  const bool on_top = head[0] > env.world().layout().platform_x + 0.3;
+  if (on_top && !field_.empty()) {
     // Walk down the distance field from module 1's cell for `lookahead` metres.
     int i = std::clamp(int(std::lround((head[0] - x0_) / cell_)), 0, nx_ - 1);
     int j = std::clamp(int(std::lround((head[1] - y0_) / cell_)), 0, ny_ - 1);
+    if (field_[std::size_t(i) * ny_ + j] < 0) {
+      // Inside an inflated obstacle: start from the nearest cell with a path.
+      int best_i = i, best_j = j, best_d2 = 1 << 30;
+      const int r = int(1.0 / cell_);
+      for (int di = -r; di <= r; ++di)
+        for (int dj = -r; dj <= r; ++dj) {
+          const int x = i + di, y = j + dj;
+          if (x < 0 || y < 0 || x >= nx_ || y >= ny_ || field_[std::size_t(x) * ny_ + y] < 0) continue;
+          if (di * di + dj * dj < best_d2) best_d2 = di * di + dj * dj, best_i = x, best_j = y;
+        }
+      i = best_i;
+      j = best_j;
+    }
     const int hops = int(p_.lookahead / cell_);
     for (int h = 0; h < hops; ++h) {
       int bi = i, bj = j;
@@ -91,8 +108,7 @@ void ScriptedPilot::act(const MultiTaskEnv& env, float a[control::kActionSize],
       gy = env.world().layout().target_y;
     }
   }
-  const bool climbing = !env.stairs_climbed();
-  if (climbing) {  // straight up the middle of the stairs
+  if (!on_top) {  // straight up the middle of the stairs
     gx = head[0] + 1.0;
     gy = 0.0;
   }

@@ -1,7 +1,8 @@
 // A scripted (not learned) controller for the demo and the physics table. It
-// uses ground truth: while the stairs are not climbed it drives straight up
-// them in stair mode with a fixed gait; then it follows a path planned on the
-// known obstacle layout (grid distance field) in flat mode.
+// uses ground truth: while the stairs are not climbed it uses stair mode with
+// a fixed gait, steering straight up the stairs until module 1 is on the flat
+// area; from there it follows a path planned on the known obstacle layout
+// (grid distance field), in flat mode once the whole chain is on the top.
 #pragma once
 
 #include <vector>
