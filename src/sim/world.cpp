@@ -154,7 +154,6 @@ void World::reconfigure(int modules) {
   if (modules >= modules_ || modules < 2)
     throw std::invalid_argument("reconfigure may only shed tail modules: " + std::to_string(modules_) +
                                 " -> " + std::to_string(modules) + " is not allowed");
-  const mjModel* old_m = model_;
   const mjData* old_d = data_;
   const int old_n = modules_;
   bind(modules);
@@ -166,7 +165,6 @@ void World::reconfigure(int modules) {
   std::memcpy(data_->qacc_warmstart, old_d->qacc_warmstart, sizeof(double) * model_->nv);
   std::memcpy(data_->ctrl, old_d->ctrl, sizeof(double) * model_->nu);
   std::memcpy(data_->warning, old_d->warning, sizeof(data_->warning));
-  (void)old_m;
   for (int k = modules; k < old_n; ++k) {
     shed_energy_ += energy_[k];
     energy_[k] = 0;
