@@ -2,6 +2,8 @@
 
 #include <torch/torch.h>
 
+#include <dlfcn.h>
+
 #include <sstream>
 
 namespace comorph::rl {
@@ -43,7 +45,16 @@ void check_device_name(const std::string& name) {
 }
 
 void set_torch_threads(int intra_op_threads, int inter_op_threads) {
-  if (intra_op_threads > 0) at::set_num_threads(intra_op_threads);
+  if (intra_op_threads > 0) {
+    at::set_num_threads(intra_op_threads);
+    // Debian's libtorch runs its matrix products in OpenBLAS (pthread build),
+    // whose own pool ignores torch's setting and defaults to one thread per
+    // core: on a shared 2-core machine that oversubscribes badly. Set it too,
+    // when OpenBLAS is the BLAS in this process.
+    using SetThreads = void (*)(int);
+    if (auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads")))
+      set(intra_op_threads);
+  }
   static bool inter_op_set = false;
   if (inter_op_threads > 0 && !inter_op_set) {
     try {

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <numeric>
 #include <random>
@@ -34,8 +36,8 @@ double mean(const std::vector<double>& v) {
   return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
 }
 
-// A one-step task with an image and a vector: a bright 3x3 spot sits in one
-// of `actions` horizontal positions of a 1 x 12 x 12 depth image (background
+// A one-step task with an image and a vector: a bright 2x2 spot sits in one
+// of `positions` horizontal positions of a 1 x 8 x 8 depth image (background
 // 0.01, the paper's range). Discrete: pick the spot's position (reward 1,
 // else 0) among the valid actions, which always include the right one.
 // Continuous: output a = (spot position scaled to [-1, 1]) + 0.5 * vector[0];
@@ -44,7 +46,7 @@ class SpotEnv final : public rl::Env {
  public:
   SpotEnv(bool discrete, int positions) : discrete_(discrete), positions_(positions) {}
   std::string name() const override { return "Spot"; }
-  rl::ObservationSpec observation_spec() const override { return {1, 12, 12, discrete_ ? 0 : 2}; }
+  rl::ObservationSpec observation_spec() const override { return {1, 8, 8, discrete_ ? 0 : 2}; }
   rl::ActionSpec action_spec() const override {
     return discrete_ ? rl::ActionSpec{rl::ActionKind::kDiscrete, positions_}
                      : rl::ActionSpec{rl::ActionKind::kContinuous, 1};
@@ -53,10 +55,10 @@ class SpotEnv final : public rl::Env {
   void reset(rl::Observation& o) override {
     spot_ = std::uniform_int_distribution<int>(0, positions_ - 1)(rng_);
     offset_ = std::uniform_real_distribution<float>(-1.0f, 1.0f)(rng_);
-    o.image.assign(144, 0.01f);
-    const int x0 = spot_ * (12 - 3) / (positions_ - 1);
-    for (int y = 4; y < 7; ++y)
-      for (int x = x0; x < x0 + 3; ++x) o.image[y * 12 + x] = 1.0f;
+    o.image.assign(64, 0.01f);
+    const int x0 = spot_ * (8 - 2) / (positions_ - 1);
+    for (int y = 3; y < 5; ++y)
+      for (int x = x0; x < x0 + 2; ++x) o.image[y * 8 + x] = 1.0f;
     if (discrete_) {
       o.vector.clear();
       o.valid_actions.assign(positions_, 0);
@@ -88,12 +90,78 @@ class SpotEnv final : public rl::Env {
   std::mt19937_64 rng_{0};
 };
 
+// A point on a line, x in [-2, 2], moved by the action: x' = x + 0.1 a;
+// reward -x^2; 40 steps, then truncated (never terminated), so that the
+// value must be bootstrapped through the truncation. Starting at
+// x ~ U(-1, 1): doing nothing scores about -13, going to 0 at full speed
+// about -1.
+class PointEnv final : public rl::Env {
+ public:
+  std::string name() const override { return "Point"; }
+  rl::ObservationSpec observation_spec() const override { return {0, 0, 0, 1}; }
+  rl::ActionSpec action_spec() const override { return {rl::ActionKind::kContinuous, 1}; }
+  void seed(std::uint64_t seed) override { rng_.seed(seed); }
+  void reset(rl::Observation& o) override {
+    x_ = std::uniform_real_distribution<double>(-1.0, 1.0)(rng_);
+    steps_ = 0;
+    o.vector = {static_cast<float>(x_)};
+  }
+  rl::StepResult step(const rl::Action& a, rl::Observation& next) override {
+    x_ = std::clamp(x_ + 0.1 * a.continuous[0], -2.0, 2.0);
+    rl::StepResult r;
+    r.reward = static_cast<float>(-x_ * x_);
+    r.truncated = ++steps_ >= 40;
+    next.vector = {static_cast<float>(x_)};
+    return r;
+  }
+
+ private:
+  double x_ = 0;
+  int steps_ = 0;
+  std::mt19937_64 rng_{0};
+};
+
+// A corridor of 8 cells (one-hot observation); action 0 steps left, 1 right.
+// Reaching cell 7 pays 1 and terminates; 30 steps truncate. From cell 0 the
+// optimal return is 1 and Q*(cell 0, right) = gamma^6.
+class CorridorEnv final : public rl::Env {
+ public:
+  std::string name() const override { return "Corridor"; }
+  rl::ObservationSpec observation_spec() const override { return {0, 0, 0, 8}; }
+  rl::ActionSpec action_spec() const override { return {rl::ActionKind::kDiscrete, 2}; }
+  void seed(std::uint64_t) override {}
+  void reset(rl::Observation& o) override {
+    cell_ = 0;
+    steps_ = 0;
+    observe(o);
+  }
+  rl::StepResult step(const rl::Action& a, rl::Observation& next) override {
+    cell_ = std::clamp(cell_ + (a.discrete == 1 ? 1 : -1), 0, 7);
+    rl::StepResult r;
+    r.terminated = cell_ == 7;
+    r.reward = r.terminated ? 1.0f : 0.0f;
+    r.truncated = !r.terminated && ++steps_ >= 30;
+    observe(next);
+    return r;
+  }
+  void observe(rl::Observation& o) const {
+    o.vector.assign(8, 0.0f);
+    o.vector[cell_] = 1.0f;
+  }
+
+ private:
+  int cell_ = 0, steps_ = 0;
+};
+
 // An env loop whose state survives between calls (for checkpoint tests).
 struct Rollout {
   rl::Env& env;
   rl::Observation obs, next;
   rl::Action action;
-  Rollout(rl::Env& e) : env(e) { env.reset(obs); }
+  Rollout(rl::Env& e, const rl::Observation* resume_from = nullptr) : env(e) {
+    if (resume_from) obs = *resume_from;  // continue where a saved run stopped
+    else env.reset(obs);
+  }
   // Runs n steps; appends every action's first component and every reward.
   void run(rl::Learner& learner, int n, std::vector<double>& trace) {
     for (int t = 0; t < n; ++t) {
@@ -129,45 +197,47 @@ YAML::Node small_dqn() {
 
 // ---- learning ------------------------------------------------------------------
 
-TEST(Learning, DqnSolvesCartPole) {
-  rl::CartPoleEnv env, eval_env;
-  env.seed(1);
-  eval_env.seed(2);
-  YAML::Node config = rl::load_yaml_file(rl::classic_config_path("cartpole", "dqn"));
-  config["hidden_sizes"] = std::vector<int>{64, 64};
-  config["gradient_steps"] = 64;  // half the updates of the preset: faster, still learns
+TEST(Learning, DqnLearnsCorridorValues) {
+  CorridorEnv env, eval_env;
+  YAML::Node config = small_dqn();
+  config["gamma"] = 0.9;
+  config["epsilon_decay"] = 2000;
   auto learner = rl::make_learner("dqn", env.observation_spec(), env.action_spec(), config, "test", 1);
-  const double untrained = mean(rl::evaluate(eval_env, *learner, 5));
-  rl::train(env, *learner, 25000);
-  const double trained = mean(rl::evaluate(eval_env, *learner, 5));
-  // Random/untrained policies last ~10-50 steps.
-  EXPECT_LT(untrained, 150);
-  EXPECT_GT(trained, 150) << "untrained " << untrained;
+  EXPECT_LT(mean(rl::evaluate(eval_env, *learner, 1)), 1.0);  // untrained: walks into a wall
+  rl::train(env, *learner, 4000);
+  EXPECT_EQ(mean(rl::evaluate(eval_env, *learner, 1)), 1.0);
+  // The values follow gamma^(steps to the goal - 1): bootstrapping, terminal handling.
+  auto& dqn = static_cast<rl::Dqn&>(*learner);
+  rl::Observation o;
+  for (int cell : {0, 3, 6}) {
+    o.vector.assign(8, 0.0f);
+    o.vector[cell] = 1.0f;
+    EXPECT_NEAR(dqn.q_values(o)[1], std::pow(0.9, 6 - cell), 0.08) << "cell " << cell;
+  }
 }
 
-TEST(Learning, Td3SwingsUpPendulum) {
-  rl::PendulumEnv env, eval_env;
+TEST(Learning, Td3DrivesPointToOrigin) {
+  PointEnv env, eval_env;
   env.seed(1);
   eval_env.seed(2);
   auto learner = rl::make_learner("td3", env.observation_spec(), env.action_spec(), small_td3(), "test", 1);
-  const double untrained = mean(rl::evaluate(eval_env, *learner, 5));
-  rl::train(env, *learner, 6000);
-  const double trained = mean(rl::evaluate(eval_env, *learner, 5));
-  // Untrained/broken controllers score about -1200 .. -1600; solved is about -150.
-  EXPECT_LT(untrained, -700);
-  EXPECT_GT(trained, -700) << "untrained " << untrained;
+  const double untrained = mean(rl::evaluate(eval_env, *learner, 20));
+  rl::train(env, *learner, 2500);
+  const double trained = mean(rl::evaluate(eval_env, *learner, 20));
+  EXPECT_GT(trained, -3.0) << "untrained " << untrained;  // optimal about -1, idle about -13
+  EXPECT_LT(untrained, -3.0);
 }
 
-TEST(Learning, SacSwingsUpPendulum) {
-  rl::PendulumEnv env, eval_env;
+TEST(Learning, SacDrivesPointToOrigin) {
+  PointEnv env, eval_env;
   env.seed(1);
   eval_env.seed(2);
   auto learner = rl::make_learner("sac", env.observation_spec(), env.action_spec(), small_sac(), "test", 1);
-  const double untrained = mean(rl::evaluate(eval_env, *learner, 5));
-  rl::train(env, *learner, 6000);
-  const double trained = mean(rl::evaluate(eval_env, *learner, 5));
-  EXPECT_LT(untrained, -700);
-  EXPECT_GT(trained, -700) << "untrained " << untrained;
+  const double untrained = mean(rl::evaluate(eval_env, *learner, 20));
+  rl::train(env, *learner, 2500);
+  const double trained = mean(rl::evaluate(eval_env, *learner, 20));
+  EXPECT_GT(trained, -3.0) << "untrained " << untrained;
+  EXPECT_LT(untrained, -3.0);
 }
 
 TEST(Learning, DqnReadsImagesWithThePaperNetworkAndMask) {
@@ -191,11 +261,12 @@ TEST(Learning, Td3ReadsImagePlusVectorThroughTheSharedEncoder) {
   env.seed(1);
   eval_env.seed(2);
   YAML::Node config = small_td3();
+  config["batch_size"] = 32;
   config["share_encoder"] = true;
   config["image_features"] = 8;
   auto learner = rl::make_learner("td3", env.observation_spec(), env.action_spec(), config, "test", 1);
   const double untrained = mean(rl::evaluate(eval_env, *learner, 100));
-  rl::train(env, *learner, 1500);
+  rl::train(env, *learner, 1000);
   const double trained = mean(rl::evaluate(eval_env, *learner, 100));
   // A constant action scores about -0.45; the exact answer scores 0.
   EXPECT_GT(trained, -0.15) << "untrained " << untrained;
@@ -242,8 +313,7 @@ void expect_exact_resume(const std::string& algo, EnvT env, const YAML::Node& co
   EnvT env_b = static_cast<EnvT&>(ra.env);  // the env's state and RNG at the save
   auto b = rl::make_learner(algo, env.observation_spec(), env.action_spec(), config, "t", 999);
   b->load(path);
-  Rollout rb(env_b);
-  rb.obs = ra.obs;
+  Rollout rb(env_b, &ra.obs);
   trace_a.clear();
   ra.run(*a, second, trace_a);
   rb.run(*b, second, trace_b);
