@@ -7,6 +7,7 @@
 
 #include <time.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <vector>
@@ -38,8 +39,8 @@ int main(int argc, char** argv) {
   fmt::print("bench_sim: {} control steps per case, depth {}x{}, {} physics steps of {:.3f} s per control step\n",
              steps, config.robot.depth_width, config.robot.depth_height,
              int(config.robot.control_period / config.robot.physics_timestep + 0.5), config.robot.physics_timestep);
-  fmt::print("{:>7} {:>14} {:>14} {:>14} {:>14} {:>10} {:>12} {:>16}\n", "modules", "env steps/s", "env us/step",
-             "raw us/step", "depth us/img", "env/raw", "overhead %", "wall steps/s");
+  fmt::print("{:>7} {:>14} {:>14} {:>14} {:>14} {:>10} {:>12} {:>16} {:>8}\n", "modules", "env steps/s",
+             "env us/step", "raw us/step", "depth us/img", "env/raw", "overhead %", "wall steps/s", "replay");
   for (int n : {2, 6, 10}) {
     task::MultiTaskEnv env(config);
     task::EpisodeSpec spec;
@@ -49,47 +50,54 @@ int main(int argc, char** argv) {
     // A stair-mode wave up the stairs: contacts with steps, hinges moving.
     const float action[5] = {0.8f, 0.0f, 0.5f, -0.5f, 0.5f};
     env.reset(spec);
-    // Record the trajectory's start states so that the raw run replays the same physics.
-    std::vector<double> ctrl;
-    int done_resets = 0;
+    // The env run records its ctrl and episode starts so that the raw run
+    // replays exactly the same physics (same states, contacts, solver work).
+    const int nu = env.world().model()->nu;
+    std::vector<double> ctrl_log(std::size_t(steps) * nu);
+    std::vector<char> reset_before(steps, 0);
     const double w0 = wall_now();
     const auto t0 = Clock::now();
     for (int i = 0; i < steps; ++i) {
       if (env.done()) {
         env.reset(spec);
-        ++done_resets;
+        reset_before[i] = 1;
       }
       env.step(action, control::MotionMode::stair);
+      std::copy(env.world().data()->ctrl, env.world().data()->ctrl + nu, ctrl_log.begin() + std::size_t(i) * nu);
     }
     const double env_s = seconds_since(t0);
     const double env_wall_s = wall_now() - w0;
+    const std::vector<double> env_final(env.world().data()->qpos, env.world().data()->qpos + env.world().model()->nq);
 
-    // Raw physics: the same model and start state, 16 mj_step per control step, ctrl
-    // from the same motion mode (computing ctrl is part of the env's overhead).
+    // Raw physics: 16 x mj_step per control step on a copy of the model and the
+    // episode's start state, with the recorded ctrl.
     env.reset(spec);
     const mjModel* m = env.world().model();
+    mjData* start = mj_makeData(m);
     mjData* d = mj_makeData(m);
-    mj_copyData(d, m, env.world().data());
-    control::MotorCommand cmd;
+    mj_copyData(start, m, env.world().data());
+    mj_copyData(d, m, start);
     const int substeps = env.world().substeps();
-    std::vector<double> c(m->nu);
-    control::compute_command(config.motion, control::MotionMode::stair, action, 0.0, n, config.robot.wheel_radius,
-                             config.robot.wheel_max_speed, cmd);
-    control::command_to_ctrl(cmd, n, c.data());
-    std::vector<double> qpos0(d->qpos, d->qpos + m->nq);
     const auto t1 = Clock::now();
     for (int i = 0; i < steps; ++i) {
-      if (i % 400 == 0) {  // episodes of similar length as the env's
-        mj_resetData(m, d);
-        std::copy(qpos0.begin(), qpos0.end(), d->qpos);
-      }
-      control::compute_command(config.motion, control::MotionMode::stair, action, d->time, n,
-                               config.robot.wheel_radius, config.robot.wheel_max_speed, cmd);
-      control::command_to_ctrl(cmd, n, d->ctrl);
+      if (reset_before[i]) mj_copyData(d, m, start);
+      std::copy(ctrl_log.begin() + std::size_t(i) * nu, ctrl_log.begin() + std::size_t(i + 1) * nu, d->ctrl);
       for (int s = 0; s < substeps; ++s) mj_step(m, d);
     }
     const double raw_s = seconds_since(t1);
+    // Untimed check that the replay is the env's physics: with the env's one
+    // mj_kinematics per control step (it renormalises the root quaternion in
+    // qpos, which changes the last bits) the end state is bit-identical.
+    mj_copyData(d, m, start);
+    for (int i = 0; i < steps; ++i) {
+      if (reset_before[i]) mj_copyData(d, m, start);
+      std::copy(ctrl_log.begin() + std::size_t(i) * nu, ctrl_log.begin() + std::size_t(i + 1) * nu, d->ctrl);
+      for (int s = 0; s < substeps; ++s) mj_step(m, d);
+      mj_kinematics(m, d);
+    }
+    const bool same = std::equal(env_final.begin(), env_final.end(), d->qpos);
     mj_deleteData(d);
+    mj_deleteData(start);
 
     // Depth image alone.
     std::vector<float> depth(config.robot.depth_width * config.robot.depth_height);
@@ -99,11 +107,12 @@ int main(int argc, char** argv) {
     const double depth_s = seconds_since(t2);
 
     const double env_us = 1e6 * env_s / steps, raw_us = 1e6 * raw_s / steps;
-    fmt::print("{:>7} {:>14.0f} {:>14.1f} {:>14.1f} {:>14.1f} {:>10.3f} {:>12.1f} {:>16.0f}\n", n, steps / env_s,
-               env_us, raw_us, 1e6 * depth_s / images, env_us / raw_us, 100.0 * (env_us / raw_us - 1.0),
-               steps / env_wall_s);
+    fmt::print("{:>7} {:>14.0f} {:>14.1f} {:>14.1f} {:>14.1f} {:>10.3f} {:>12.1f} {:>16.0f} {:>8}\n", n,
+               steps / env_s, env_us, raw_us, 1e6 * depth_s / images, env_us / raw_us,
+               100.0 * (env_us / raw_us - 1.0), steps / env_wall_s, same ? "same" : "DIFFERS");
   }
   fmt::print("times are thread CPU time (cost per core); wall steps/s includes waiting for a shared core\n");
+  fmt::print("replay: the raw run replays the env's ctrl from the same start states (same = bit-identical end state, checked untimed)\n");
   fmt::print("env/raw: env step time over 16 x mj_step of the same chain (1.25 = the 25 % goal)\n");
   return 0;
 }
