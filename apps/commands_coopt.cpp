@@ -65,7 +65,8 @@ comorph::report::FWeights f_weights(const CooptConfig& c) {
   w.w_t = c.eval.w_t;
   w.w_e = c.eval.w_e;
   w.w_d = c.eval.w_d;
-  w.t_max_s = c.env.task.max_steps * c.env.robot.control_period;
+  // t_max stays report's 112 s (the paper's 3500 x 32 ms cap) so that F is
+  // comparable between presets with different step caps.
   w.battery_capacity_J = c.env.robot.battery_capacity;
   return w;
 }
@@ -168,7 +169,11 @@ void train(const std::string& config_path, const std::vector<std::string>& sets,
   std::fprintf(stderr, "%s %s: %d episodes, %lld control steps, %.0f s wall, %.0f steps/s\n",
                finished ? "finished" : "interrupted, checkpoint written:", run_dir.c_str(), trainer.episodes_done(),
                static_cast<long long>(trainer.env_steps()), wall, wall > 0 ? trainer.env_steps() / wall : 0.0);
-  if (!finished) std::fprintf(stderr, "continue with: comorph train --resume %s\n", run_dir.c_str());
+  if (!finished) {
+    std::fprintf(stderr, "continue with: comorph train --resume %s\n", run_dir.c_str());
+    std::fflush(stderr);
+    std::exit(130);  // interrupted: a calling script (make run) stops here too
+  }
 }
 
 void eval(const std::string& run_dir, const std::string& scenario, int episodes, int seed, int workers) {

@@ -17,6 +17,7 @@
 #include "coopt/segment.hpp"
 #include "coopt/trainer.hpp"
 #include "perception/params.hpp"
+#include "perception/scene_classifier.hpp"
 
 namespace comorph::coopt {
 namespace {
@@ -222,8 +223,9 @@ TEST(Trainer, SceneSwitchEndsTheSegmentAndMasksTheNextChoice) {
     EXPECT_EQ(mine[1].modules, l.configurations.back());
     // R2 over both segments: all of R1, minus sigma3 * E_c (not climbed: no r_s).
     const double sigma3 = c.env.task.r2.sigma3;
-    if (l.termination != "success")
+    if (l.termination != "success") {
       EXPECT_NEAR(mine[0].r2 + mine[1].r2, l.return_R1 - sigma3 * l.stairs_energy_J, 1e-3 * (1 + std::abs(l.return_R1)));
+    }
   }
   EXPECT_EQ(d, r.decisions.size());
   fs::remove_all(dir);
@@ -243,6 +245,23 @@ TEST(Trainer, FixedBaselineAndSacRun) {
   EXPECT_FALSE(sac.decisions.empty());
   fs::remove_all(a);
   fs::remove_all(b);
+}
+
+// scene_source: classifier runs the ResNet-18 on the last 10 depth frames at
+// every detector decision (here an untrained one: only the plumbing is tested).
+TEST(Trainer, ClassifierSceneSourceRunsTheHierarchy) {
+  const std::string dir = temp_dir("cls"), weights = temp_dir("cls_weights");
+  perception::ClassifierParams p;
+  p.image_size = 8;  // the ci preset's depth images
+  p.width = 8;
+  perception::SceneClassifier(p, 3).save(weights);
+  const RunResult r = run_ci({"trainer.scene_source=classifier", "trainer.classifier_dir=" + weights,
+                              "perception.classifier.image_size=8", "perception.classifier.width=8"},
+                             dir);
+  EXPECT_EQ(r.logs.size(), 6u);
+  EXPECT_FALSE(r.decisions.empty());
+  fs::remove_all(dir);
+  fs::remove_all(weights);
 }
 
 TEST(Evaluate, GreedyEpisodesCycleHeightsAndDoNotDependOnWorkers) {
