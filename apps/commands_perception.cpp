@@ -5,26 +5,37 @@
 //                            [--config configs/perception.yaml] [--epochs E] [--seed S]
 //   comorph classifier eval --model DIR --data FILE [--config FILE] [--switch-trials N] [--seed S]
 //   comorph classifier synthetic --out FILE [--count N] [--seed S]
+//   comorph classifier dataset --out FILE [--seeds A:B] [--frames-per-seed N] [--seed S]
+//                              [--config-dir configs/sim]
+//   comorph classifier prepare --out DIR [--config configs/perception.yaml] [--train-seeds A:B]
+//                              [--eval-seeds C:D] [--epochs E] [--frames-per-seed N] [--seed S]
+//                              [--config-dir configs/sim]
 //
-// Extending: the simulation side adds `comorph classifier dataset ...` (depth
-// images rendered and labelled by the simulator, written with
-// perception::DatasetWriter) HERE, in add_classifier_subcommands() below, next
-// to `synthetic`, so every classifier command lives in this one file.
+// `dataset` and `prepare` take their images from the simulator
+// (coopt/scene_dataset.hpp: scripted-pilot runs and level views of seeded
+// scenes, labelled from ground truth); docs/perception.md, "Data from the
+// simulator".
 #include <spdlog/spdlog.h>
 
+#include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
+#include <fstream>
 #include <iostream>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 
 #include "command_registry.hpp"
+#include "coopt/scene_dataset.hpp"
 #include "perception/dataset.hpp"
 #include "perception/perception_config.hpp"
 #include "perception/scene_classifier.hpp"
 #include "perception/switch_evaluation.hpp"
 #include "perception/synthetic.hpp"
 #include "perception/training.hpp"
+#include "task/env_config.hpp"
 
 namespace {
 
@@ -117,6 +128,217 @@ void run_eval(const EvalOptions& o) {
   }
 }
 
+// ---- data from the simulator: `dataset` and `prepare` ----
+
+namespace coopt = comorph::coopt;
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// One stderr line about every tenth of the seeds (and the last).
+coopt::SeedProgress seed_progress(const std::string& what) {
+  return [what](int done, int total, const coopt::SceneDatasetStats& st) {
+    const int every = std::max(1, total / 10);
+    if (done % every == 0 || done == total)
+      std::cerr << fmt::format("{}: seed {}/{}, {} images, {} control steps simulated, {:.1f} s\n", what, done,
+                               total, st.images(), st.run_steps, st.seconds);
+  };
+}
+
+struct DatasetOptions {
+  std::string out, seeds = "1:40", config_dir = "configs/sim";
+  int frames_per_seed = coopt::SceneDatasetParams{}.frames_per_seed;
+  std::uint64_t seed = 1;
+};
+
+void run_dataset(const DatasetOptions& o) {
+  coopt::SceneDatasetParams p;
+  coopt::parse_seed_range(o.seeds, "--seeds", p.first_seed, p.last_seed);
+  p.frames_per_seed = o.frames_per_seed;
+  p.seed = o.seed;
+  if (const std::string err = p.validate(); !err.empty()) throw std::runtime_error(err);
+  const comorph::task::EnvConfig env = comorph::task::load_env_config(o.config_dir);
+  std::cerr << fmt::format("dataset: scene seeds {}..{} ({} seeds), {} images a seed ({:.0f} % from scripted runs), "
+                           "{}x{} pixels, generator seed {}\n",
+                           p.first_seed, p.last_seed, p.seeds(), p.frames_per_seed, 100 * p.run_fraction,
+                           env.robot.depth_height, env.robot.depth_width, p.seed);
+  const coopt::SceneDatasetStats st = coopt::write_scene_dataset(o.out, env, p, seed_progress("dataset"));
+  std::cout << "wrote " << o.out << ": " << coopt::format_class_balance(st) << "\n";
+  std::cout << fmt::format("{}; {} control steps simulated; {:.1f} s\n", coopt::format_run_ends(st), st.run_steps,
+                           st.seconds);
+}
+
+struct PrepareOptions {
+  std::string out, config = "configs/perception.yaml", config_dir = "configs/sim";
+  std::string train_seeds = "1:40", eval_seeds = "1001:1010";
+  std::optional<int> epochs;
+  int frames_per_seed = coopt::SceneDatasetParams{}.frames_per_seed;
+  std::uint64_t seed = 1;
+};
+
+std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "null"; }
+
+std::string json_delays(const perception::SwitchDelayReport& d, double max) {
+  return fmt::format(
+      "{{\"mean_delay_steps\": {}, \"max_delay_steps\": {}, \"detected\": {}, \"missed\": {}, "
+      "\"false_switches\": {}}}",
+      json_number(d.mean_delay()), json_number(max), d.detected, d.missed, d.false_switches);
+}
+
+void write_text_atomically(const fs::path& path, const std::string& text) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream f(tmp);
+    f << text;
+    if (!f) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, path);
+}
+
+void run_prepare(const PrepareOptions& o) {
+  const auto t_start = std::chrono::steady_clock::now();
+  // ---- everything is checked before anything is written ----
+  perception::PerceptionConfig cfg = perception::load_perception_config(o.config);
+  if (o.epochs) cfg.training.epochs = *o.epochs;
+  for (const std::string& err : {cfg.classifier.validate(), cfg.training.validate(), cfg.switch_detector.validate()})
+    if (!err.empty()) throw std::runtime_error(o.config + ": " + err);
+  const comorph::task::EnvConfig env = comorph::task::load_env_config(o.config_dir);
+  if (cfg.classifier.image_size != env.robot.depth_width || cfg.classifier.image_size != env.robot.depth_height)
+    throw std::runtime_error(fmt::format(
+        "{}: classifier.image_size {} does not match the camera of {}/robot.yaml ({}x{} pixels)", o.config,
+        cfg.classifier.image_size, o.config_dir, env.robot.depth_height, env.robot.depth_width));
+  if (cfg.classifier.classes != 3)
+    throw std::runtime_error(fmt::format("{}: classifier.classes {}: the simulator labels 3 scene classes",
+                                         o.config, cfg.classifier.classes));
+  coopt::SceneDatasetParams train_p, eval_p;
+  coopt::parse_seed_range(o.train_seeds, "--train-seeds", train_p.first_seed, train_p.last_seed);
+  coopt::parse_seed_range(o.eval_seeds, "--eval-seeds", eval_p.first_seed, eval_p.last_seed);
+  if (!(train_p.last_seed < eval_p.first_seed || eval_p.last_seed < train_p.first_seed))
+    throw std::runtime_error(fmt::format("--train-seeds {} and --eval-seeds {} overlap: held-out seeds must be disjoint",
+                                         o.train_seeds, o.eval_seeds));
+  train_p.frames_per_seed = eval_p.frames_per_seed = o.frames_per_seed;
+  train_p.seed = eval_p.seed = o.seed;
+  for (const std::string& err : {train_p.validate(), eval_p.validate()})
+    if (!err.empty()) throw std::runtime_error(err);
+  coopt::EpisodeSwitchParams episodes;
+  episodes.first_seed = eval_p.first_seed;
+  episodes.last_seed = eval_p.last_seed;
+  episodes.seed = o.seed;
+  const fs::path out(o.out);
+  if (fs::exists(out) && !(fs::is_directory(out) && fs::is_empty(out)))
+    throw std::runtime_error(o.out + " exists and is not an empty directory; choose another --out");
+  // Everything goes to DIR.partial, renamed to DIR at the end: an error leaves no DIR.
+  const fs::path stage = out.string() + ".partial";
+  fs::remove_all(stage);
+  fs::create_directories(stage);
+  try {
+    std::ostringstream report;  // also written to DIR/classifier-eval.txt
+    auto say = [&](const std::string& text) {
+      std::cout << text << std::flush;
+      report << text;
+    };
+    say(fmt::format("classifier prepare: train seeds {}..{}, held-out seeds {}..{}, {} images a seed, "
+                    "generator seed {}\n",
+                    train_p.first_seed, train_p.last_seed, eval_p.first_seed, eval_p.last_seed,
+                    train_p.frames_per_seed, o.seed));
+
+    // ---- data ----
+    const coopt::SceneDataset train = coopt::make_scene_dataset(env, train_p, seed_progress("training data"));
+    const coopt::SceneDataset eval = coopt::make_scene_dataset(env, eval_p, seed_progress("held-out data"));
+    perception::save_dataset((stage / "train.bin").string(), train.data);
+    perception::save_dataset((stage / "eval.bin").string(), eval.data);
+    say(fmt::format("training data (train.bin): {}; {:.1f} s\n", coopt::format_class_balance(train.stats),
+                    train.stats.seconds));
+    say(fmt::format("held-out data (eval.bin): {}; {:.1f} s\n", coopt::format_class_balance(eval.stats),
+                    eval.stats.seconds));
+
+    // ---- training ----
+    say(fmt::format("classifier: ResNet-18, width {} channels, {}x{} pixels, {} classes; {} epochs, batch {} images, "
+                    "lr {}, seed {}, {} thread(s)\n",
+                    cfg.classifier.width, cfg.classifier.image_size, cfg.classifier.image_size,
+                    cfg.classifier.classes, cfg.training.epochs, cfg.training.batch_size,
+                    cfg.training.learning_rate, cfg.training.seed, cfg.training.threads));
+    const auto t_train = std::chrono::steady_clock::now();
+    perception::TrainResult r = perception::train_classifier(train.data, cfg.classifier, cfg.training, &eval.data);
+    const double train_seconds = seconds_since(t_train);
+    if (!r.epochs.empty()) report << perception::format_epoch(r.epochs.back(), cfg.training.epochs) << "\n";
+    say(fmt::format("training: {:.1f} s\n", train_seconds));
+
+    // ---- held-out accuracy: all, and per source ----
+    say(fmt::format("held-out evaluation (seeds {}..{}, never trained on)\n", eval_p.first_seed, eval_p.last_seed));
+    say(perception::format_evaluation(r.eval, cfg.classifier));
+    double source_accuracy[2] = {NAN, NAN};
+    std::size_t source_count[2] = {0, 0};
+    for (const coopt::FrameSource src : {coopt::FrameSource::run, coopt::FrameSource::view}) {
+      std::vector<std::size_t> idx;
+      for (std::size_t i = 0; i < eval.source.size(); ++i)
+        if (eval.source[i] == src) idx.push_back(i);
+      if (idx.empty()) continue;
+      const perception::EvalResult e = perception::evaluate_classifier(r.model, eval.data.subset(idx));
+      const int k = static_cast<int>(src);
+      source_accuracy[k] = e.accuracy;
+      source_count[k] = e.count;
+      say(fmt::format("  {} frames: accuracy {:.2f} % ({} images)\n",
+                      src == coopt::FrameSource::run ? "scripted-run" : "level-view", 100 * e.accuracy, e.count));
+    }
+
+    // ---- switch delay in real episodes on the held-out seeds ----
+    perception::SceneClassifier::set_threads(1);
+    const coopt::EpisodeSwitchReport sw = coopt::evaluate_switching_in_episodes(
+        env, r.model, cfg.switch_detector, episodes, [](int done, int total) {
+          std::cerr << fmt::format("switch episodes: {}/{}\n", done, total);
+        });
+    const auto& d = cfg.switch_detector;
+    say(fmt::format("switch detector: every {} control steps, last {} frames, > {:.0f} % agree\n", d.interval,
+                    d.window, 100 * d.agreement));
+    say(coopt::format_episode_switch_report(sw));
+    say(fmt::format("  ({:.1f} s)\n", sw.seconds));
+
+    // ---- save ----
+    r.model.save(stage.string());
+    const double total_seconds = seconds_since(t_start);
+    say(fmt::format("wall time: data {:.1f} s, training {:.1f} s, switch episodes {:.1f} s, total {:.1f} s\n",
+                    train.stats.seconds + eval.stats.seconds, train_seconds, sw.seconds, total_seconds));
+    write_text_atomically(stage / "classifier-eval.txt", report.str());
+    std::string confusion = "[";
+    for (std::size_t t = 0; t < r.eval.confusion.size(); ++t) {
+      confusion += t ? ", [" : "[";
+      for (std::size_t p = 0; p < r.eval.confusion[t].size(); ++p)
+        confusion += (p ? ", " : "") + std::to_string(r.eval.confusion[t][p]);
+      confusion += "]";
+    }
+    confusion += "]";
+    write_text_atomically(
+        stage / "classifier-eval.json",
+        fmt::format("{{\n  \"train_seeds\": [{}, {}],\n  \"eval_seeds\": [{}, {}],\n  \"train_images\": {},\n"
+                    "  \"eval_images\": {},\n  \"width\": {},\n  \"epochs\": {},\n  \"eval_accuracy\": {},\n"
+                    "  \"eval_accuracy_run_frames\": {},\n  \"eval_accuracy_view_frames\": {},\n"
+                    "  \"eval_run_frames\": {},\n  \"eval_view_frames\": {},\n"
+                    "  \"confusion\": {},\n  \"confusion_layout\": \"rows = true class, columns = predicted; "
+                    "stairs, obstacle_field, target_zone\",\n"
+                    "  \"switch_episodes\": {},\n  \"switch_initial_wrong\": {},\n  \"switch\": {},\n"
+                    "  \"switch_rule_only\": {},\n  \"data_seconds\": {},\n  \"train_seconds\": {},\n"
+                    "  \"switch_seconds\": {},\n  \"total_seconds\": {}\n}}\n",
+                    train_p.first_seed, train_p.last_seed, eval_p.first_seed, eval_p.last_seed, train.data.size(),
+                    eval.data.size(), cfg.classifier.width, cfg.training.epochs, json_number(r.eval.accuracy),
+                    json_number(source_accuracy[0]), json_number(source_accuracy[1]), source_count[0],
+                    source_count[1], confusion, sw.episodes, sw.initial_wrong,
+                    json_delays(sw.monitor, sw.monitor_max_delay), json_delays(sw.rule_only, sw.rule_only_max_delay),
+                    json_number(train.stats.seconds + eval.stats.seconds), json_number(train_seconds),
+                    json_number(sw.seconds), json_number(total_seconds)));
+    if (fs::exists(out)) fs::remove(out);  // an empty directory (checked above)
+    fs::rename(stage, out);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(stage, ec);
+    throw;
+  }
+  std::cout << fmt::format("saved {0}/classifier.pt, classifier.yaml, classifier-eval.txt, classifier-eval.json, "
+                           "train.bin, eval.bin\nuse it: scene_source: classifier, classifier_dir: {0}\n",
+                           o.out);
+}
+
 void add_classifier_subcommands(CLI::App& app) {
   auto* cls = app.add_subcommand("classifier", "train and evaluate the depth scene classifier");
   cls->require_subcommand(1);
@@ -159,7 +381,33 @@ void add_classifier_subcommands(CLI::App& app) {
     std::cout << "wrote " << synth_out << ": " << describe(d, perception::ClassifierParams{}) << "\n";
   });
 
-  // `dataset` (simulator-rendered images) will be added here by the sim side.
+  auto* data = cls->add_subcommand(
+      "dataset", "write a depth dataset rendered by the simulator and labelled from ground truth");
+  static DatasetOptions dop;
+  data->add_option("--out", dop.out, "dataset file to write")->required();
+  data->add_option("--seeds", dop.seeds, "scene seeds A:B, inclusive (held-out sets: a disjoint range)");
+  data->add_option("--frames-per-seed", dop.frames_per_seed, "images per scene seed (half from a scripted run)")
+      ->check(CLI::PositiveNumber);
+  data->add_option("--seed", dop.seed, "generator seed (chain lengths, obstacle counts, frame picks, view poses)");
+  data->add_option("--config-dir", dop.config_dir, "directory of robot/scene/motion/task.yaml");
+  data->callback([] { run_dataset(dop); });
+
+  auto* prep = cls->add_subcommand(
+      "prepare", "simulator data (train + held-out seeds), training, held-out accuracy and switch delays in "
+                 "scripted episodes; saves everything to --out");
+  static PrepareOptions po;
+  prep->add_option("--out", po.out, "directory to create (must not exist or be empty)")->required();
+  prep->add_option("--config", po.config, "perception preset");
+  prep->add_option("--train-seeds", po.train_seeds, "scene seeds A:B (inclusive) of the training data");
+  prep->add_option("--eval-seeds", po.eval_seeds,
+                   "scene seeds C:D (inclusive, disjoint from the training seeds) of the held-out data and the "
+                   "switch-delay episodes");
+  prep->add_option("--epochs", po.epochs, "passes over the training data (overrides the preset)")
+      ->check(CLI::PositiveNumber);
+  prep->add_option("--frames-per-seed", po.frames_per_seed, "images per scene seed")->check(CLI::PositiveNumber);
+  prep->add_option("--seed", po.seed, "generator seed of the data and the episodes");
+  prep->add_option("--config-dir", po.config_dir, "directory of robot/scene/motion/task.yaml");
+  prep->callback([] { run_prepare(po); });
 }
 
 comorph::cli::CommandRegistration registration{add_classifier_subcommands};
