@@ -272,8 +272,8 @@ void run_prepare(const PrepareOptions& o) {
     std::size_t source_count[2] = {0, 0};
     for (const coopt::FrameSource src : {coopt::FrameSource::run, coopt::FrameSource::view}) {
       std::vector<std::size_t> idx;
-      for (std::size_t i = 0; i < eval.source.size(); ++i)
-        if (eval.source[i] == src) idx.push_back(i);
+      for (std::size_t i = 0; i < eval.info.size(); ++i)
+        if (eval.info[i].source == src) idx.push_back(i);
       if (idx.empty()) continue;
       const perception::EvalResult e = perception::evaluate_classifier(r.model, eval.data.subset(idx));
       const int k = static_cast<int>(src);

@@ -12,9 +12,6 @@
 #include <stdexcept>
 
 #include "perception/scene_monitor.hpp"
-#include "sim/scene.hpp"
-#include "task/multitask_env.hpp"
-#include "task/scripted_pilot.hpp"
 
 namespace comorph::coopt {
 namespace {
@@ -60,12 +57,6 @@ task::EpisodeSpec draw_spec(std::mt19937_64& rng, std::uint64_t scene_seed, int 
   return spec;
 }
 
-task::ScriptedPilot make_pilot() {
-  task::ScriptedPilot pilot;
-  // The stair gait the physics-table search picks (as `comorph demo`).
-  pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};
-  return pilot;
-}
 
 // A level view's pose is usable when module 1 and its camera stand on the
 // course, clear of obstacles by `margin`.
@@ -84,6 +75,18 @@ bool view_pose_ok(const task::EnvConfig& env, const sim::SceneLayout& s, double 
 }
 
 }  // namespace
+
+task::ScriptedPilot dataset_pilot() {
+  task::ScriptedPilot pilot;
+  // The stair gait the physics-table search picks (as `comorph demo`).
+  pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};
+  return pilot;
+}
+
+task::EpisodeSpec scene_episode(const SceneDatasetParams& p, std::uint64_t scene_seed) {
+  std::mt19937_64 rng = scene_rng(p.seed, scene_seed, 1);
+  return draw_spec(rng, scene_seed, p.min_modules, p.max_modules, p.min_obstacles, p.max_obstacles);
+}
 
 const char* frame_source_name(FrameSource s) { return s == FrameSource::run ? "run" : "view"; }
 
@@ -159,6 +162,7 @@ SceneDatasetStats generate_scene_frames(const task::EnvConfig& config, const Sce
   stats.run_ends.assign(static_cast<int>(task::Termination::step_cap) + 1, 0);
   std::vector<float> frames;       // the run's depth images, step after step
   std::vector<int> labels;         // the run's labels
+  std::vector<double> heads;       // the run's module 1 positions x, y (m)
   std::vector<float> view(pixels);
   const int total = static_cast<int>(p.seeds());
 
@@ -173,18 +177,27 @@ SceneDatasetStats generate_scene_frames(const task::EnvConfig& config, const Sce
     // (a) the scripted run: every step's frame is a candidate.
     frames.clear();
     labels.clear();
+    heads.clear();
+    FrameInfo info;
+    info.scene_seed = scene_seed;
+    info.modules = spec.modules;
+    info.obstacles = spec.obstacles;
     if (run_quota > 0) {
-      task::ScriptedPilot pilot = make_pilot();
+      task::ScriptedPilot pilot = dataset_pilot();
       pilot.plan(env);
-      frames.insert(frames.end(), env.depth(), env.depth() + pixels);
-      labels.push_back(env.scene_label());
+      auto record = [&] {
+        frames.insert(frames.end(), env.depth(), env.depth() + pixels);
+        labels.push_back(env.scene_label());
+        heads.push_back(env.world().module_pos(0)[0]);
+        heads.push_back(env.world().module_pos(0)[1]);
+      };
+      record();
       float action[control::kActionSize];
       control::MotionMode mode = env.mode();
       while (!env.done() && env.step_count() < p.max_run_steps) {
         pilot.act(env, action, mode);
         env.step(action, mode);
-        frames.insert(frames.end(), env.depth(), env.depth() + pixels);
-        labels.push_back(env.scene_label());
+        record();
       }
       stats.run_steps += env.step_count();
       if (env.done() && env.last().reason == task::Termination::success) ++stats.runs_reached_target;
@@ -209,8 +222,12 @@ SceneDatasetStats generate_scene_frames(const task::EnvConfig& config, const Sce
           }
       }
       std::sort(picked.begin(), picked.end());  // time order
+      info.source = FrameSource::run;
       for (const std::size_t i : picked) {
-        sink(frames.data() + i * pixels, labels[i], FrameSource::run);
+        info.step = static_cast<int>(i);
+        info.x = heads[2 * i];
+        info.y = heads[2 * i + 1];
+        sink(frames.data() + i * pixels, labels[i], info);
         ++count[labels[i]];
         ++stats.run_per_class[labels[i]];
       }
@@ -244,7 +261,13 @@ SceneDatasetStats generate_scene_frames(const task::EnvConfig& config, const Sce
                                              scene_seed, kClassNames[want]));
       const int label = env.world().render_view_from(x, y, yaw, view.data());
       if (label != want) throw std::logic_error("scene dataset: render_view_from labels differently from scene_label");
-      sink(view.data(), label, FrameSource::view);
+      info.source = FrameSource::view;
+      info.variant = spec.variant;
+      info.step = -1;
+      info.x = x;
+      info.y = y;
+      info.yaw = yaw;
+      sink(view.data(), label, info);
       ++count[label];
       ++stats.view_per_class[label];
     }
@@ -263,9 +286,9 @@ SceneDataset make_scene_dataset(const task::EnvConfig& env, const SceneDatasetPa
   out.data = perception::Dataset(env.robot.depth_height, env.robot.depth_width, kClasses);
   out.stats = generate_scene_frames(
       env, params,
-      [&](const float* depth, int label, FrameSource source) {
+      [&](const float* depth, int label, const FrameInfo& info) {
         out.data.add(depth, label);
-        out.source.push_back(source);
+        out.info.push_back(info);
       },
       progress);
   return out;
@@ -276,7 +299,7 @@ SceneDatasetStats write_scene_dataset(const std::string& path, const task::EnvCo
   if (const std::string err = params.validate(); !err.empty()) throw std::invalid_argument(err);
   perception::DatasetWriter writer(path, env.robot.depth_height, env.robot.depth_width, kClasses);
   const SceneDatasetStats stats = generate_scene_frames(
-      env, params, [&](const float* depth, int label, FrameSource) { writer.add(depth, label); }, progress);
+      env, params, [&](const float* depth, int label, const FrameInfo&) { writer.add(depth, label); }, progress);
   writer.finish();
   return stats;
 }
@@ -355,7 +378,7 @@ EpisodeSwitchReport evaluate_switching_in_episodes(const task::EnvConfig& config
   for (std::uint64_t scene_seed = p.first_seed;; ++scene_seed) {
     std::mt19937_64 rng = scene_rng(p.seed, scene_seed, 2);
     env.reset(draw_spec(rng, scene_seed, p.min_modules, p.max_modules, p.min_obstacles, p.max_obstacles));
-    task::ScriptedPilot pilot = make_pilot();
+    task::ScriptedPilot pilot = dataset_pilot();
     pilot.plan(env);
     const int first = classifier.classify(env.depth(), env.depth_height(), env.depth_width());
     monitor.reset(first);

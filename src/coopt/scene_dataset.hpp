@@ -31,7 +31,10 @@
 #include "perception/dataset.hpp"
 #include "perception/scene_classifier.hpp"
 #include "perception/switch_detector.hpp"
+#include "sim/scene.hpp"
 #include "task/env_config.hpp"
+#include "task/multitask_env.hpp"
+#include "task/scripted_pilot.hpp"
 
 namespace comorph::coopt {
 
@@ -84,8 +87,20 @@ struct SceneDatasetStats {
   std::vector<std::size_t> per_class() const;  // run + view per class
 };
 
+// Where an image comes from (for tests and inspection).
+struct FrameInfo {
+  FrameSource source = FrameSource::run;
+  std::uint64_t scene_seed = 0;  // the scene
+  int modules = 0;               // chain length of the scene's scripted run
+  int obstacles = 0;             // K of the scene
+  sim::Variant variant = sim::Variant::standard;  // of the scene the image shows
+  int step = -1;                 // run: control steps since reset (0 = the reset frame); view: -1
+  double x = 0, y = 0;           // m: module 1's position (run) or the view's position
+  double yaw = 0;                // rad: the view's heading (run: 0, not recorded)
+};
+
 // Receives each image (height*width depths, row-major, [0.01, 1]) with its label.
-using FrameSink = std::function<void(const float* depth, int label, FrameSource source)>;
+using FrameSink = std::function<void(const float* depth, int label, const FrameInfo& info)>;
 // Called after each scene seed (seeds done so far, seeds in total, stats so far).
 using SeedProgress = std::function<void(int done, int total, const SceneDatasetStats& stats)>;
 
@@ -94,10 +109,16 @@ using SeedProgress = std::function<void(int done, int total, const SceneDatasetS
 SceneDatasetStats generate_scene_frames(const task::EnvConfig& env, const SceneDatasetParams& params,
                                         const FrameSink& sink, const SeedProgress& progress = nullptr);
 
-// The same in memory, with the source of every image.
+// The episode a scene seed's run uses (chain length and K drawn from
+// (params.seed, scene_seed); standard variant).
+task::EpisodeSpec scene_episode(const SceneDatasetParams& params, std::uint64_t scene_seed);
+// The scripted pilot of the runs (the physics table's stair gait, as `comorph demo`).
+task::ScriptedPilot dataset_pilot();
+
+// The same in memory, with the origin of every image.
 struct SceneDataset {
   perception::Dataset data;          // 3 classes
-  std::vector<FrameSource> source;   // one per image
+  std::vector<FrameInfo> info;       // one per image
   SceneDatasetStats stats;
 };
 SceneDataset make_scene_dataset(const task::EnvConfig& env, const SceneDatasetParams& params,
