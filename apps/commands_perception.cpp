@@ -147,8 +147,9 @@ coopt::SeedProgress seed_progress(const std::string& what) {
 }
 
 struct DatasetOptions {
-  std::string out, seeds = "1:40", config_dir = "configs/sim";
+  std::string out, seeds = "1:30", config_dir = "configs/sim";
   int frames_per_seed = coopt::SceneDatasetParams{}.frames_per_seed;
+  double run_fraction = coopt::SceneDatasetParams{}.run_fraction;
   std::uint64_t seed = 1;
 };
 
@@ -156,6 +157,7 @@ void run_dataset(const DatasetOptions& o) {
   coopt::SceneDatasetParams p;
   coopt::parse_seed_range(o.seeds, "--seeds", p.first_seed, p.last_seed);
   p.frames_per_seed = o.frames_per_seed;
+  p.run_fraction = o.run_fraction;
   p.seed = o.seed;
   if (const std::string err = p.validate(); !err.empty()) throw std::runtime_error(err);
   const comorph::task::EnvConfig env = comorph::task::load_env_config(o.config_dir);
@@ -171,9 +173,10 @@ void run_dataset(const DatasetOptions& o) {
 
 struct PrepareOptions {
   std::string out, config = "configs/perception.yaml", config_dir = "configs/sim";
-  std::string train_seeds = "1:40", eval_seeds = "1001:1010";
+  std::string train_seeds = "1:30", eval_seeds = "1001:1010";
   std::optional<int> epochs;
   int frames_per_seed = coopt::SceneDatasetParams{}.frames_per_seed;
+  double run_fraction = coopt::SceneDatasetParams{}.run_fraction;
   std::uint64_t seed = 1;
 };
 
@@ -218,6 +221,7 @@ void run_prepare(const PrepareOptions& o) {
     throw std::runtime_error(fmt::format("--train-seeds {} and --eval-seeds {} overlap: held-out seeds must be disjoint",
                                          o.train_seeds, o.eval_seeds));
   train_p.frames_per_seed = eval_p.frames_per_seed = o.frames_per_seed;
+  train_p.run_fraction = eval_p.run_fraction = o.run_fraction;
   train_p.seed = eval_p.seed = o.seed;
   for (const std::string& err : {train_p.validate(), eval_p.validate()})
     if (!err.empty()) throw std::runtime_error(err);
@@ -386,8 +390,11 @@ void add_classifier_subcommands(CLI::App& app) {
   static DatasetOptions dop;
   data->add_option("--out", dop.out, "dataset file to write")->required();
   data->add_option("--seeds", dop.seeds, "scene seeds A:B, inclusive (held-out sets: a disjoint range)");
-  data->add_option("--frames-per-seed", dop.frames_per_seed, "images per scene seed (half from a scripted run)")
+  data->add_option("--frames-per-seed", dop.frames_per_seed, "images per scene seed")
       ->check(CLI::PositiveNumber);
+  data->add_option("--run-fraction", dop.run_fraction,
+                   "share of a seed's images from its scripted run (the rest: level views), 0..1")
+      ->check(CLI::Range(0.0, 1.0));
   data->add_option("--seed", dop.seed, "generator seed (chain lengths, obstacle counts, frame picks, view poses)");
   data->add_option("--config-dir", dop.config_dir, "directory of robot/scene/motion/task.yaml");
   data->callback([] { run_dataset(dop); });
@@ -405,6 +412,9 @@ void add_classifier_subcommands(CLI::App& app) {
   prep->add_option("--epochs", po.epochs, "passes over the training data (overrides the preset)")
       ->check(CLI::PositiveNumber);
   prep->add_option("--frames-per-seed", po.frames_per_seed, "images per scene seed")->check(CLI::PositiveNumber);
+  prep->add_option("--run-fraction", po.run_fraction,
+                   "share of a seed's images from its scripted run (the rest: level views), 0..1")
+      ->check(CLI::Range(0.0, 1.0));
   prep->add_option("--seed", po.seed, "generator seed of the data and the episodes");
   prep->add_option("--config-dir", po.config_dir, "directory of robot/scene/motion/task.yaml");
   prep->callback([] { run_prepare(po); });

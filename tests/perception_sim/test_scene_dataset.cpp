@@ -35,6 +35,7 @@ coopt::SceneDatasetParams small(std::uint64_t first, std::uint64_t last, int fra
   p.last_seed = last;
   p.frames_per_seed = frames;
   p.max_run_steps = 450;
+  p.run_fraction = 0.5;
   return p;
 }
 
