@@ -94,6 +94,7 @@ void read_common(torch::serialize::InputArchive& a, LearnerCounters& c, std::mt1
                              algorithm);
   torch::Tensor t;
   a.read("counters", t);
+  t = t.to(torch::kCPU);  // the archive may have been mapped to a GPU
   const auto* v = t.data_ptr<std::int64_t>();
   c.transitions = v[0];
   c.episodes = v[1];

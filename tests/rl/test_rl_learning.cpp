@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unistd.h>
+
 #include <filesystem>
 #include <numeric>
 #include <random>
@@ -29,7 +31,10 @@ struct SingleThread {
 } single_thread;
 
 std::string temp_path(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("comorph_rl_" + name)).string();
+  // The pid keeps concurrent test runs (other build trees) apart.
+  return (std::filesystem::temp_directory_path() /
+          ("comorph_rl_" + std::to_string(::getpid()) + "_" + name))
+      .string();
 }
 
 double mean(const std::vector<double>& v) {

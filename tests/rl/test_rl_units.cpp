@@ -4,6 +4,8 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <unistd.h>
+
 #include <filesystem>
 #include <random>
 
@@ -21,7 +23,10 @@ namespace rl = comorph::rl;
 namespace {
 
 std::string temp_path(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("comorph_rl_" + name)).string();
+  // The pid keeps concurrent test runs (other build trees) apart.
+  return (std::filesystem::temp_directory_path() /
+          ("comorph_rl_" + std::to_string(::getpid()) + "_" + name))
+      .string();
 }
 
 rl::Observation vector_obs(std::vector<float> v, std::vector<std::uint8_t> valid = {}) {
@@ -335,7 +340,9 @@ TEST(Dqn, TargetMaximisesOverNextValidActionsAndRespectsTermination) {
   EXPECT_EQ(y[3].item<float>(), 2.0f);
   // The masked max differs from the unmasked one when an invalid action is best.
   const float best_any = q_next.max().item<float>();
-  if (best_any != best_valid) EXPECT_GT(std::abs(y[0].item<float>() - (1.0f + 0.9f * best_any)), 1e-6);
+  if (best_any != best_valid) {
+    EXPECT_GT(std::abs(y[0].item<float>() - (1.0f + 0.9f * best_any)), 1e-6);
+  }
 }
 
 TEST(Dqn, EpsilonScheduleIsLinearThenFlat) {
@@ -384,9 +391,15 @@ TEST(Config, EveryPresetLoadsAndUnknownFieldsAreRejected) {
     const std::string algo = std::string(name).find("td3") != std::string::npos   ? "td3"
                              : std::string(name).find("sac") != std::string::npos ? "sac"
                                                                                   : "dqn";
-    if (algo == "td3") EXPECT_NO_THROW(rl::Td3Config::from_yaml(node, path)) << path;
-    if (algo == "sac") EXPECT_NO_THROW(rl::SacConfig::from_yaml(node, path)) << path;
-    if (algo == "dqn") EXPECT_NO_THROW(rl::DqnConfig::from_yaml(node, path)) << path;
+    if (algo == "td3") {
+      EXPECT_NO_THROW(rl::Td3Config::from_yaml(node, path)) << path;
+    }
+    if (algo == "sac") {
+      EXPECT_NO_THROW(rl::SacConfig::from_yaml(node, path)) << path;
+    }
+    if (algo == "dqn") {
+      EXPECT_NO_THROW(rl::DqnConfig::from_yaml(node, path)) << path;
+    }
   }
   const rl::Td3Config paper =
       rl::Td3Config::from_yaml(rl::load_yaml_file(rl::rl_config_dir() + "/robot_td3_paper.yaml"), "x");
