@@ -212,7 +212,7 @@ TEST(SceneDataset, SmallClassifierBeatsChanceOnHeldOutSeedsAndDetectsSwitches) {
   ASSERT_EQ(r.eval.count, eval.data.size());
   std::cout << "held-out accuracy " << 100 * r.eval.accuracy << " % on " << r.eval.count << " images\n"
             << perception::format_evaluation(r.eval, cp);
-  EXPECT_GT(r.eval.accuracy, 0.60);  // chance: ~0.33 (balanced classes)
+  EXPECT_GT(r.eval.accuracy, 0.70);  // chance ~0.33 (balanced); 80-89 % measured over 2 data x 4 training seeds
 
   coopt::EpisodeSwitchParams ep;
   ep.first_seed = 501;
