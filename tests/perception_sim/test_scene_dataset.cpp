@@ -130,7 +130,7 @@ TEST(SceneDataset, AllClassesDepthRangeAndBalance) {
     ASSERT_GE(v, 0.01f);
     ASSERT_LE(v, 1.0f);
   }
-  // Images are not all alike: both sources present, several distinct depths per image on average.
+  // Both sources are present.
   std::set<int> sources;
   for (const auto& f : d.info) sources.insert(static_cast<int>(f.source));
   EXPECT_EQ(sources.size(), 2u);
