@@ -415,9 +415,11 @@ EpisodeSwitchReport evaluate_switching_in_episodes(const task::EnvConfig& config
 
 std::string format_episode_switch_report(const EpisodeSwitchReport& r) {
   auto line = [](const char* what, const perception::SwitchDelayReport& d, double max) {
-    return fmt::format("  {}: mean delay {:.1f} control steps (max {:.0f}), {} of {} scene changes detected, "
-                       "{} missed, {} false switches\n",
-                       what, d.mean_delay(), max, d.detected, d.detected + d.missed, d.missed, d.false_switches);
+    const std::string delay = d.delays.empty() ? std::string("no delay (nothing detected)")
+                                               : fmt::format("mean delay {:.1f} control steps (max {:.0f})",
+                                                             d.mean_delay(), max);
+    return fmt::format("  {}: {}, {} of {} scene changes detected, {} missed, {} false switches\n", what, delay,
+                       d.detected, d.detected + d.missed, d.missed, d.false_switches);
   };
   return fmt::format("switch delay in {} scripted episodes ({} control steps of 32 ms, {} reached the target; "
                      "first frame misclassified in {}):\n",
