@@ -98,6 +98,11 @@ ClassicResult run_classic(const ClassicOptions& o) {
   std::unique_ptr<Env> eval_env = make_classic_env(o.env);
   env->seed(o.seed);
   eval_env->seed(o.seed + 1000003);  // evaluation episodes differ from training ones
+  const bool discrete = env->action_spec().kind == ActionKind::kDiscrete;
+  if ((o.algorithm == "dqn") != discrete)
+    throw std::invalid_argument(o.algorithm + " cannot act in " + env->name() +
+                                (discrete ? ": discrete actions, use dqn"
+                                          : ": continuous actions, use td3 or sac"));
   const std::string path = o.config_path.empty() ? classic_config_path(o.env, o.algorithm) : o.config_path;
   std::unique_ptr<Learner> learner = make_learner(
       o.algorithm, env->observation_spec(), env->action_spec(), load_yaml_file(path), path, o.seed);
