@@ -174,7 +174,9 @@ void run_dataset(const DatasetOptions& o) {
 struct PrepareOptions {
   std::string out, config = "configs/perception.yaml", config_dir = "configs/sim";
   std::string train_seeds = "1:30", eval_seeds = "1001:1010";
-  std::optional<int> epochs;
+  // Held-out accuracy on this data plateaus after 2-3 epochs: 6 (not the
+  // preset's 10) keeps `prepare` at ~1.5 min on an idle 2-core machine.
+  int epochs = 6;
   int frames_per_seed = coopt::SceneDatasetParams{}.frames_per_seed;
   double run_fraction = coopt::SceneDatasetParams{}.run_fraction;
   std::uint64_t seed = 1;
@@ -203,7 +205,7 @@ void run_prepare(const PrepareOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
   // ---- everything is checked before anything is written ----
   perception::PerceptionConfig cfg = perception::load_perception_config(o.config);
-  if (o.epochs) cfg.training.epochs = *o.epochs;
+  cfg.training.epochs = o.epochs;
   for (const std::string& err : {cfg.classifier.validate(), cfg.training.validate(), cfg.switch_detector.validate()})
     if (!err.empty()) throw std::runtime_error(o.config + ": " + err);
   const comorph::task::EnvConfig env = comorph::task::load_env_config(o.config_dir);
@@ -409,7 +411,8 @@ void add_classifier_subcommands(CLI::App& app) {
   prep->add_option("--eval-seeds", po.eval_seeds,
                    "scene seeds C:D (inclusive, disjoint from the training seeds) of the held-out data and the "
                    "switch-delay episodes");
-  prep->add_option("--epochs", po.epochs, "passes over the training data (overrides the preset)")
+  prep->add_option("--epochs", po.epochs,
+                   "passes over the training data (default 6, not the preset's: held-out accuracy plateaus after 2-3)")
       ->check(CLI::PositiveNumber);
   prep->add_option("--frames-per-seed", po.frames_per_seed, "images per scene seed")->check(CLI::PositiveNumber);
   prep->add_option("--run-fraction", po.run_fraction,
