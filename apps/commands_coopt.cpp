@@ -60,16 +60,8 @@ void append_episode(const std::string& path, const EpisodeLog& log) {
 
 std::string fmt_rate(double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.2f}", v); }
 
-comorph::report::FWeights f_weights(const CooptConfig& c) {
-  comorph::report::FWeights w;
-  w.w_t = c.eval.w_t;
-  w.w_e = c.eval.w_e;
-  w.w_d = c.eval.w_d;
-  // t_max stays report's 112 s (the paper's 3500 x 32 ms cap) so that F is
-  // comparable between presets with different step caps.
-  w.battery_capacity_J = c.env.robot.battery_capacity;
-  return w;
-}
+// F(H) as the env defines it (task/rewards.hpp, env.task.objective in the config).
+const comorph::task::ObjectiveWeights& f_weights(const CooptConfig& c) { return c.env.task.objective; }
 
 const char* kEvalColumns =
     "train_episode,env_steps,wall_s,episodes,success_0.04,success_0.06,success_0.08,success_avg,"

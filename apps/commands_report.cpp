@@ -49,23 +49,17 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   auto* summarize = app.add_subcommand(
       "summarize", "summarise an episode CSV into the evaluation JSON (success per height, time, energy, F(H))");
   static std::string episodes_csv, json_out;
-  static comorph::report::FWeights weights;
-  static bool paper_fit = false;
+  static comorph::task::ObjectiveWeights weights;
   summarize->add_option("episodes", episodes_csv, "episode CSV (docs/report.md)")->required()->check(CLI::ExistingFile);
   summarize->add_option("--out,-o", json_out, "JSON to write (default: print it)");
   summarize->add_option("--w-t", weights.w_t, "F(H) weight of time")->capture_default_str();
   summarize->add_option("--w-e", weights.w_e, "F(H) weight of energy")->capture_default_str();
   summarize->add_option("--w-d", weights.w_d, "F(H) weight of distance")->capture_default_str();
   summarize->add_option("--t-max", weights.t_max_s, "time that makes T = 1, seconds")->capture_default_str();
-  summarize->add_flag("--paper-fit", paper_fit, "t_max 120 s and E per single battery: the reading that gives the paper's F");
+  summarize->add_option("--energy-scale", weights.energy_scale_J, "energy that makes E = 1, joules")
+      ->capture_default_str();
   summarize->callback([] {
-    comorph::report::FWeights w = weights;
-    if (paper_fit) {
-      const auto fit = comorph::report::FWeights::paper_fit();
-      w.t_max_s = fit.t_max_s;
-      w.energy_per_module = fit.energy_per_module;
-    }
-    const auto metrics = comorph::report::summarize(comorph::report::read_episodes_csv(episodes_csv), w);
+    const auto metrics = comorph::report::summarize(comorph::report::read_episodes_csv(episodes_csv), weights);
     if (json_out.empty()) {
       std::cout << comorph::report::to_json(metrics).dump(2) << "\n";
     } else {

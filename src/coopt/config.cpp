@@ -153,9 +153,6 @@ EvalParams read_eval(const YAML::Node& n, const std::string& source) {
   f.add("eval.episodes", &p.episodes, 1, 1000000);
   f.add("eval.seed", &p.seed, 0, 2000000000);
   f.add("eval.workers", &p.workers, 1, 64);
-  f.add("eval.w_t", &p.w_t, 0, 100);
-  f.add("eval.w_e", &p.w_e, 0, 100);
-  f.add("eval.w_d", &p.w_d, 0, 100);
   f.apply(n, "eval.");
   return p;
 }

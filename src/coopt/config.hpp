@@ -62,9 +62,6 @@ struct EvalParams {
   int episodes = 30;     // greedy episodes; stair height of episode i = heights[i % 3]
   int seed = 700000;     // seed of episode i is seed + i
   int workers = 2;       // threads, each with its own env and network copies
-  double w_t = 1.0;      // F(H) weights for eval-<scenario>.json (report::FWeights defaults,
-  double w_e = 2.0;      //   fitted to the paper's tables: docs/report.md)
-  double w_d = 2.0;
 };
 
 struct CooptConfig {

@@ -29,24 +29,8 @@ const nlohmann::json& need(const nlohmann::json& j, const std::string& key, cons
 
 }  // namespace
 
-FWeights FWeights::paper_fit() {
-  FWeights w;
-  w.t_max_s = 120.0;
-  w.energy_per_module = false;
-  return w;
-}
-
-double objective_F(const EpisodeRecord& e, const FWeights& w) {
-  if (w.t_max_s <= 0 || w.battery_capacity_J <= 0)
-    throw std::invalid_argument("FWeights: t_max_s and battery_capacity_J must be > 0");
-  if (w.energy_per_module && e.modules_total < 1)
-    throw std::invalid_argument(fmt::format("episode {}: modules_total {} must be >= 1 to normalise energy",
-                                            e.episode, e.modules_total));
-  const double T = e.time_s / w.t_max_s;
-  const double capacity = w.battery_capacity_J * (w.energy_per_module ? e.modules_total : 1);
-  const double E = e.energy_J / capacity;
-  const double D = e.distance_fraction;
-  return -w.w_t * T - w.w_e * E + w.w_d * D;
+double objective_F(const EpisodeRecord& e, const task::ObjectiveWeights& w) {
+  return task::objective(w, e.time_s, e.energy_J, e.distance_fraction);
 }
 
 const std::vector<std::string>& paper_stair_keys() {
@@ -56,7 +40,7 @@ const std::vector<std::string>& paper_stair_keys() {
 
 std::string stair_key(double stair_height_m) { return fmt::format("{:.2f}", stair_height_m); }
 
-Metrics summarize(const std::vector<EpisodeRecord>& records, const FWeights& weights) {
+Metrics summarize(const std::vector<EpisodeRecord>& records, const task::ObjectiveWeights& weights) {
   Metrics m;
   m.episodes = static_cast<int>(records.size());
   std::map<std::string, std::pair<int, int>> per_height;  // key -> (successes, episodes)

@@ -11,33 +11,14 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "report/episode_record.hpp"
+#include "task/rewards.hpp"
 
 namespace comorph::report {
 
-// Weights and scales of F(H) = -w_t T - w_e E + w_d D (paper Eq. 1), with
-// T = time / t_max, E = energy / capacity, D = distance done / initial distance.
-// The paper does not print its weights. Fitting its nine (Time, Battery,
-// Success avg, F) columns of Tables I and II by least squares with gnuplot gives
-// w_t = 0.94, w_e = 2.01, w_d = 2.01 for t_max = 112 s and E = Battery/20000 J;
-// with w = (1, 2, 2) and t_max = 120 s every paper F is matched within 0.02
-// (docs/report.md). So the weights default to (1, 2, 2); T and E follow
-// DESIGN.md (t_max = the 3500-step cap, E per battery on board), and
-// paper_fit() gives the reading that reproduces the paper's F column.
-struct FWeights {
-  double w_t = 1.0;                    // weight of the time term T (dimensionless)
-  double w_e = 2.0;                    // weight of the energy term E (dimensionless)
-  double w_d = 2.0;                    // weight of the distance term D (dimensionless)
-  double t_max_s = 112.0;              // time that makes T = 1, seconds (3500 steps x 32 ms)
-  double battery_capacity_J = 20000.0; // one module's battery, joules
-  bool energy_per_module = true;       // E = energy / (modules_total x capacity); false: energy / capacity
-
-  // The reading under which the paper's F values come out: t_max = 120 s,
-  // E = energy / one battery's capacity.
-  static FWeights paper_fit();
-};
-
-// F(H) of one episode (throws if modules_total < 1 with energy_per_module).
-double objective_F(const EpisodeRecord& episode, const FWeights& weights);
+// F(H) of one episode: task::objective (Eq. 1, the project's one definition,
+// with its weights and scales documented in task/rewards.hpp) of the record's
+// time, energy and distance fraction.
+double objective_F(const EpisodeRecord& episode, const task::ObjectiveWeights& weights);
 
 // The three stair heights of the paper's protocol, as summary keys.
 const std::vector<std::string>& paper_stair_keys();  // {"0.04", "0.06", "0.08"}
@@ -59,7 +40,7 @@ struct Metrics {
   std::map<std::string, int> terminations;  // termination reason -> episodes
 };
 
-Metrics summarize(const std::vector<EpisodeRecord>& records, const FWeights& weights = {});
+Metrics summarize(const std::vector<EpisodeRecord>& records, const task::ObjectiveWeights& weights = {});
 
 // JSON with exactly the keys success_rate, time_s, energy_J, F, configurations,
 // terminations, episodes; NaN is written as null.

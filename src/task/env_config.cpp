@@ -22,6 +22,8 @@ TaskParams task_params_from_yaml(const std::string& text, const std::string& sou
   f.add("objective.w_t", &p.objective.w_t, 0, 100);
   f.add("objective.w_e", &p.objective.w_e, 0, 100);
   f.add("objective.w_d", &p.objective.w_d, 0, 100);
+  f.add("objective.t_max_s", &p.objective.t_max_s, 1e-3, 1e6);
+  f.add("objective.energy_scale_J", &p.objective.energy_scale_J, 1e-3, 1e9);
   f.add("max_steps", &p.max_steps, 1, 10000000);
   f.add("overturn_up_z", &p.overturn_up_z, -1, 1);
   f.add("start_zone_length", &p.start_zone_length, 0, 100);

@@ -210,10 +210,11 @@ Metrics MultiTaskEnv::metrics() const {
   const double* head = world_.module_pos(0);
   const double now = std::hypot(world_.layout().target_x - head[0], world_.layout().target_y - head[1]);
   m.distance_done_m = std::max(0.0, initial_distance_ - now);
-  m.T = m.time_s / (config_.task.max_steps * config_.robot.control_period);
-  m.E = m.energy_J / (initial_modules_ * config_.robot.battery_capacity);
+  const ObjectiveWeights& w = config_.task.objective;
+  m.T = m.time_s / w.t_max_s;
+  m.E = m.energy_J / w.energy_scale_J;
   m.D = initial_distance_ > 0 ? std::clamp(m.distance_done_m / initial_distance_, 0.0, 1.0) : 0.0;
-  m.F = objective(config_.task.objective, m.T, m.E, m.D);
+  m.F = objective(w, m.time_s, m.energy_J, m.D);
   return m;
 }
 

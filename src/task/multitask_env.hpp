@@ -60,8 +60,8 @@ struct Metrics {
   double energy_J = 0;           // J drawn by all modules (shed ones included)
   double initial_distance_m = 0; // start -> target, horizontal
   double distance_done_m = 0;    // initial - current distance to the target, >= 0
-  double T = 0;                  // time_s / (max_steps * control_period)
-  double E = 0;                  // energy_J / (initial modules * battery_capacity)
+  double T = 0;                  // time_s / ObjectiveWeights::t_max_s
+  double E = 0;                  // energy_J / ObjectiveWeights::energy_scale_J
   double D = 0;                  // distance_done_m / initial_distance_m, in [0, 1]
   double F = 0;                  // Eq. 1 with TaskParams::objective
 };

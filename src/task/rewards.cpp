@@ -11,8 +11,8 @@ double r2_reward(const R2Params& p, double sum_r1, bool stairs_segment, bool sta
   return p.sigma1 * sum_r1 + sigma2 * r_s + p.sigma3 * r_c;
 }
 
-double objective(const ObjectiveWeights& w, double T, double E, double D) {
-  return -w.w_t * T - w.w_e * E + w.w_d * D;
+double objective(const ObjectiveWeights& w, double time_s, double energy_J, double distance_fraction) {
+  return -w.w_t * time_s / w.t_max_s - w.w_e * energy_J / w.energy_scale_J + w.w_d * distance_fraction;
 }
 
 }  // namespace comorph::task

@@ -57,21 +57,20 @@ TEST(Metrics, TimeAndEnergyAverageSuccessfulEpisodesOnly) {
 }
 
 TEST(Metrics, ObjectiveFByHand) {
-  FWeights w;
+  task::ObjectiveWeights w;
   w.w_t = 0.5;
   w.w_e = 1.5;
   w.w_d = 3.0;
   w.t_max_s = 100.0;
-  w.battery_capacity_J = 10000.0;
-  w.energy_per_module = true;
-  // F = -0.5 * t/100 - 1.5 * E/(N * 10000) + 3 * D, per episode, then the mean.
+  w.energy_scale_J = 10000.0;
+  // F = -0.5 * t/100 - 1.5 * energy/10000 + 3 * D, per episode, then the mean.
   const double by_hand[] = {
-      -0.5 * 0.40 - 1.5 * 3000.0 / 20000.0 + 3.0 * 1.0,  //
-      -0.5 * 1.12 - 1.5 * 5000.0 / 20000.0 + 3.0 * 0.5,  //
-      -0.5 * 0.50 - 1.5 * 6000.0 / 40000.0 + 3.0 * 1.0,  //
-      -0.5 * 0.60 - 1.5 * 8000.0 / 40000.0 + 3.0 * 1.0,  //
-      -0.5 * 0.10 - 1.5 * 100.0 / 40000.0 + 3.0 * 0.1,   //
-      -0.5 * 1.12 - 1.5 * 9000.0 / 60000.0 + 3.0 * 0.3};
+      -0.5 * 0.40 - 1.5 * 3000.0 / 10000.0 + 3.0 * 1.0,  //
+      -0.5 * 1.12 - 1.5 * 5000.0 / 10000.0 + 3.0 * 0.5,  //
+      -0.5 * 0.50 - 1.5 * 6000.0 / 10000.0 + 3.0 * 1.0,  //
+      -0.5 * 0.60 - 1.5 * 8000.0 / 10000.0 + 3.0 * 1.0,  //
+      -0.5 * 0.10 - 1.5 * 100.0 / 10000.0 + 3.0 * 0.1,   //
+      -0.5 * 1.12 - 1.5 * 9000.0 / 10000.0 + 3.0 * 0.3};
   const auto log = hand_log();
   double sum = 0;
   for (size_t i = 0; i < log.size(); ++i) {
@@ -79,10 +78,6 @@ TEST(Metrics, ObjectiveFByHand) {
     sum += by_hand[i];
   }
   EXPECT_NEAR(summarize(log, w).F, sum / 6.0, 1e-12);
-
-  // Without per-module normalisation the energy term uses one battery.
-  w.energy_per_module = false;
-  EXPECT_NEAR(objective_F(log[5], w), -0.5 * 1.12 - 1.5 * 9000.0 / 10000.0 + 3.0 * 0.3, 1e-12);
 }
 
 TEST(Metrics, ConfigurationsPerHeightAndTerminations) {
@@ -149,12 +144,6 @@ TEST(Metrics, JsonMissingKeyIsNamed) {
     EXPECT_NE(std::string(e.what()).find("runs/x/eval-default.json"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("energy_J"), std::string::npos) << e.what();
   }
-}
-
-TEST(Metrics, EnergyPerModuleNeedsModules) {
-  auto e = hand_log()[0];
-  e.modules_total = 0;
-  EXPECT_THROW(objective_F(e, FWeights{}), std::invalid_argument);
 }
 
 }  // namespace

@@ -119,10 +119,10 @@ TEST(Env, ScriptedRunClimbsReachesTheTargetAndReportsEvents) {
   EXPECT_EQ(labels, (std::vector<int>{0, 1, 2}));
   const task::Metrics m = env.metrics();
   EXPECT_NEAR(m.energy_J, energy, 1e-6);
-  EXPECT_NEAR(m.E, energy / (4 * c.robot.battery_capacity), 1e-12);
+  EXPECT_NEAR(m.E, energy / 20000.0, 1e-12);
   EXPECT_GT(m.D, 0.9);
-  EXPECT_NEAR(m.T, m.steps / 3500.0, 1e-12);
-  EXPECT_NEAR(m.F, -m.T - m.E + m.D, 1e-12);
+  EXPECT_NEAR(m.T, m.steps * 0.032 / 120.0, 1e-12);
+  EXPECT_NEAR(m.F, -m.T - 2 * m.E + 2 * m.D, 1e-12);
   // Calibration: a competent run draws about 27 W per module.
   const double watts = m.energy_J / m.time_s / 4;
   EXPECT_GT(watts, 22.0);
