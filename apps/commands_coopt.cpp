@@ -20,7 +20,7 @@
 #include "report/episode_record.hpp"
 #include "report/metrics.hpp"
 #include "report/run_dir.hpp"
-#include "sim/yaml_fields.hpp"
+#include "common/yaml_fields.hpp"
 
 namespace {
 namespace fs = std::filesystem;

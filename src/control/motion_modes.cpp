@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "sim/yaml_fields.hpp"
+#include "common/yaml_fields.hpp"
 
 namespace comorph::control {
 
@@ -63,7 +63,7 @@ void command_to_ctrl(const MotorCommand& cmd, int modules, double* ctrl) {
 
 MotionParams motion_params_from_yaml(const std::string& text, const std::string& source,
                                      MotionParams p) {
-  sim::YamlFields f(source);
+  YamlFields f(source);
   f.add("v_straight_max", &p.v_straight_max, 0, 5);
   f.add("v_turn_max", &p.v_turn_max, 0, 5);
   f.add("amplitude_max", &p.amplitude_max, 0, 3);

@@ -7,7 +7,7 @@
 #include "rl/sac.hpp"
 #include "rl/td3.hpp"
 #include "sim/params.hpp"
-#include "sim/yaml_fields.hpp"
+#include "common/yaml_fields.hpp"
 
 namespace comorph::coopt {
 namespace {
@@ -101,8 +101,8 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
               "classifier_dir", "scenario", "stair_height", "eval_interval", "eval_episodes", "eval_seed",
               "checkpoint_interval", "progress_interval", "env_dir"});
   if (!n || n.IsNull()) return p;
-  // Numbers with ranges through sim::YamlFields (names the key and the range).
-  sim::YamlFields f(source);
+  // Numbers with ranges through YamlFields (names the key and the range).
+  YamlFields f(source);
   YAML::Node numbers(YAML::NodeType::Map);
   const std::vector<std::string> strings{"mode", "motion_algo", "scene_source", "classifier_dir", "scenario", "env_dir"};
   for (const auto& kv : n) {
@@ -149,7 +149,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
 
 EvalParams read_eval(const YAML::Node& n, const std::string& source) {
   EvalParams p;
-  sim::YamlFields f(source);
+  YamlFields f(source);
   f.add("eval.episodes", &p.episodes, 1, 1000000);
   f.add("eval.seed", &p.seed, 0, 2000000000);
   f.add("eval.workers", &p.workers, 1, 64);
@@ -230,7 +230,7 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
 }
 
 CooptConfig load_coopt_config(const std::string& path, const std::vector<std::string>& sets) {
-  return coopt_config_from_text(sim::read_text_file(path), path, sets);
+  return coopt_config_from_text(read_text_file(path), path, sets);
 }
 
 }  // namespace comorph::coopt

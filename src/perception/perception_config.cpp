@@ -1,7 +1,8 @@
 // Parameter validation and the YAML form of the perception parameters.
 #include "perception/perception_config.hpp"
 
-#include <set>
+#include "common/yaml_fields.hpp"
+
 #include <stdexcept>
 
 namespace comorph::perception {
@@ -34,90 +35,38 @@ std::string TrainParams::validate() const {
   return "";
 }
 
-namespace {
-
-[[noreturn]] void fail(const std::string& source, const std::string& key, const std::string& what) {
-  throw std::runtime_error(source + ": '" + key + "': " + what);
-}
-
-void check_keys(const YAML::Node& node, const std::string& source, const std::string& section,
-                const std::set<std::string>& allowed) {
-  if (!node.IsMap()) fail(source, section, "expected a mapping");
-  for (const auto& item : node) {
-    const std::string key = item.first.as<std::string>();
-    if (!allowed.count(key)) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      fail(source, section.empty() ? key : section + "." + key, "unknown key (expected one of: " + list + ")");
-    }
-  }
-}
-
-template <typename T>
-void read(const YAML::Node& node, const char* key, const std::string& source,
-          const std::string& section, T& out) {
-  if (!node[key]) return;
-  try {
-    out = node[key].as<T>();
-  } catch (const YAML::Exception&) {
-    fail(source, section + "." + key, "bad value '" + YAML::Dump(node[key]) + "'");
-  }
-}
-
-}  // namespace
-
 PerceptionConfig perception_config_from_yaml(const YAML::Node& root, const std::string& source) {
   PerceptionConfig cfg;
-  if (!root || root.IsNull()) return cfg;
-  check_keys(root, source, "", {"classifier", "training", "switch_detector"});
-  if (const YAML::Node n = root["classifier"]) {
-    check_keys(n, source, "classifier", {"image_size", "classes", "class_names", "width", "device"});
-    ClassifierParams& c = cfg.classifier;
-    read(n, "image_size", source, "classifier", c.image_size);
-    read(n, "classes", source, "classifier", c.classes);
-    read(n, "class_names", source, "classifier", c.class_names);
-    read(n, "width", source, "classifier", c.width);
-    read(n, "device", source, "classifier", c.device);
-  }
-  if (const YAML::Node n = root["training"]) {
-    check_keys(n, source, "training",
-               {"epochs", "batch_size", "learning_rate", "cosine_schedule", "weight_decay", "eval_fraction", "seed",
-                "threads", "progress"});
-    TrainParams& t = cfg.training;
-    read(n, "epochs", source, "training", t.epochs);
-    read(n, "batch_size", source, "training", t.batch_size);
-    read(n, "learning_rate", source, "training", t.learning_rate);
-    read(n, "cosine_schedule", source, "training", t.cosine_schedule);
-    read(n, "weight_decay", source, "training", t.weight_decay);
-    read(n, "eval_fraction", source, "training", t.eval_fraction);
-    read(n, "seed", source, "training", t.seed);
-    read(n, "threads", source, "training", t.threads);
-    read(n, "progress", source, "training", t.progress);
-  }
-  if (const YAML::Node n = root["switch_detector"]) {
-    check_keys(n, source, "switch_detector", {"interval", "window", "agreement"});
-    SwitchDetectorParams& s = cfg.switch_detector;
-    read(n, "interval", source, "switch_detector", s.interval);
-    read(n, "window", source, "switch_detector", s.window);
-    read(n, "agreement", source, "switch_detector", s.agreement);
-  }
-  for (const std::string& err :
-       {cfg.classifier.validate(), cfg.training.validate(), cfg.switch_detector.validate()})
+  ClassifierParams& c = cfg.classifier;
+  TrainParams& t = cfg.training;
+  SwitchDetectorParams& d = cfg.switch_detector;
+  // Ranges and cross-field rules live in the structs' validate(); here: keys and types.
+  YamlFields f(source);
+  f.add("classifier.image_size", &c.image_size);
+  f.add("classifier.classes", &c.classes);
+  f.add("classifier.class_names", &c.class_names);
+  f.add("classifier.width", &c.width);
+  f.add("classifier.device", &c.device);
+  f.add("training.epochs", &t.epochs);
+  f.add("training.batch_size", &t.batch_size);
+  f.add("training.learning_rate", &t.learning_rate);
+  f.add("training.cosine_schedule", &t.cosine_schedule);
+  f.add("training.weight_decay", &t.weight_decay);
+  f.add("training.eval_fraction", &t.eval_fraction);
+  f.add("training.seed", &t.seed);
+  f.add("training.threads", &t.threads);
+  f.add("training.progress", &t.progress);
+  f.add("switch_detector.interval", &d.interval);
+  f.add("switch_detector.window", &d.window);
+  f.add("switch_detector.agreement", &d.agreement);
+  f.apply(root);
+  for (const std::string& err : {c.validate(), t.validate(), d.validate()})
     if (!err.empty()) throw std::runtime_error(source + ": " + err);
   return cfg;
 }
 
 PerceptionConfig load_perception_config(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw std::runtime_error(path + ": cannot open");
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": not valid YAML: " + e.msg + " (line " +
-                             std::to_string(e.mark.line + 1) + ")");
-  }
-  return perception_config_from_yaml(root, path);
+  return perception_config_from_yaml(load_yaml_file(path), path);
 }
 
 }  // namespace comorph::perception

@@ -8,31 +8,6 @@
 
 namespace comorph::rl {
 
-YamlFields::YamlFields(const YAML::Node& node, std::string source)
-    : node_(node), source_(std::move(source)) {
-  if (node_ && !node_.IsNull() && !node_.IsMap())
-    throw std::invalid_argument(source_ + ": expected a mapping of hyperparameters");
-}
-
-void YamlFields::finish() const {
-  if (!node_ || node_.IsNull()) return;
-  for (const auto& kv : node_) {
-    const std::string key = kv.first.as<std::string>();
-    if (!seen_.count(key))
-      throw std::invalid_argument(source_ + ": unknown field \"" + key + "\"");
-  }
-}
-
-YAML::Node load_yaml_file(const std::string& path) {
-  try {
-    return YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw std::invalid_argument("cannot read YAML file " + path);
-  } catch (const YAML::Exception& e) {
-    throw std::invalid_argument(path + ": " + e.what());
-  }
-}
-
 std::string rl_config_dir() { return std::string(COMORPH_SOURCE_DIR) + "/configs/rl"; }
 
 void check_device_name(const std::string& name) {

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "common/yaml_fields.hpp"  // YamlFields, load_yaml_file: every from_yaml
 #include "rl/env.hpp"
 
 namespace torch::serialize {
@@ -69,34 +70,6 @@ struct LinearSchedule {
     return start + (end - start) * (t / duration);
   }
 };
-
-// Reads a YAML mapping into a struct field by field and rejects unknown keys,
-// naming the file and the key: a misspelt hyperparameter must not be ignored.
-class YamlFields {
- public:
-  YamlFields(const YAML::Node& node, std::string source);
-  template <typename T>
-  void read(const std::string& key, T& field) {
-    seen_.insert(key);
-    const YAML::Node value = node_[key];
-    if (!value) return;  // keep the default
-    try {
-      field = value.as<T>();
-    } catch (const YAML::Exception& e) {
-      throw std::invalid_argument(source_ + ": field \"" + key + "\" has a bad value: " + e.what());
-    }
-  }
-  void finish() const;  // throws on any key that was not read
-  const std::string& source() const { return source_; }
-
- private:
-  YAML::Node node_;
-  std::string source_;
-  std::set<std::string> seen_;
-};
-
-// Loads a YAML file (throws with the path on error).
-YAML::Node load_yaml_file(const std::string& path);
 
 // Where the YAML presets are: <source dir>/configs/rl.
 std::string rl_config_dir();

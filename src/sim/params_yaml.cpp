@@ -2,7 +2,7 @@
 #include <cmath>
 
 #include "sim/params.hpp"
-#include "sim/yaml_fields.hpp"
+#include "common/yaml_fields.hpp"
 
 namespace comorph::sim {
 

@@ -2,12 +2,12 @@
 
 #include <filesystem>
 
-#include "sim/yaml_fields.hpp"
+#include "common/yaml_fields.hpp"
 
 namespace comorph::task {
 
 TaskParams task_params_from_yaml(const std::string& text, const std::string& source, TaskParams p) {
-  sim::YamlFields f(source);
+  YamlFields f(source);
   f.add("r1.tau1", &p.r1.tau1, -1e4, 1e4);
   f.add("r1.tau2", &p.r1.tau2, -1e4, 1e4);
   f.add("r1.tau3", &p.r1.tau3, -1e4, 1e4);
@@ -39,9 +39,9 @@ EnvConfig load_env_config(const std::string& dir) {
   if (fs::exists(path("robot.yaml"))) c.robot = sim::load_robot_params(path("robot.yaml"));
   if (fs::exists(path("scene.yaml"))) c.scene = sim::load_scene_params(path("scene.yaml"));
   if (fs::exists(path("motion.yaml")))
-    c.motion = control::motion_params_from_yaml(sim::read_text_file(path("motion.yaml")), path("motion.yaml"));
+    c.motion = control::motion_params_from_yaml(read_text_file(path("motion.yaml")), path("motion.yaml"));
   if (fs::exists(path("task.yaml")))
-    c.task = task_params_from_yaml(sim::read_text_file(path("task.yaml")), path("task.yaml"));
+    c.task = task_params_from_yaml(read_text_file(path("task.yaml")), path("task.yaml"));
   return c;
 }
 

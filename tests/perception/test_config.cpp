@@ -41,8 +41,8 @@ TEST(PerceptionConfig, ReadsValuesAndRejectsBadOnes) {
   EXPECT_EQ(c.switch_detector.interval, 50);
   EXPECT_EQ(c.switch_detector.window, 10);  // untouched keys keep their defaults
 
-  EXPECT_NE(error_of("classifier: {widht: 8}").find("classifier.widht': unknown key"), std::string::npos);
-  EXPECT_NE(error_of("bogus: 1").find("'bogus': unknown key"), std::string::npos);
+  EXPECT_NE(error_of("classifier: {widht: 8}").find("classifier.widht': unknown field"), std::string::npos);
+  EXPECT_NE(error_of("bogus: 1").find("'bogus': unknown field"), std::string::npos);
   EXPECT_NE(error_of("switch_detector: {agreement: 1.5}").find("agreement must be in [0, 1)"),
             std::string::npos);
   EXPECT_NE(error_of("training: {epochs: many}").find("training.epochs': bad value"), std::string::npos);
