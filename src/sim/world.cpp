@@ -242,6 +242,11 @@ void World::render_depth_at(const double pos[3], double yaw, double pitch, float
   const double cy = std::cos(yaw), sy = std::sin(yaw), cp = std::cos(pitch), sp = std::sin(pitch);
   const double R[9] = {cy * cp, -sy, -cy * sp, sy * cp, cy, -sy * sp, sp, 0, cp};
   // Columns: x axis (cy cp, sy cp, sp), y axis (-sy, cy, 0), z axis (-cy sp, -sy sp, cp).
+  cast_depth(pos, R, out);
+}
+
+// One depth image from a camera at `pos` whose carrier frame is the row-major rotation `R`.
+void World::cast_depth(const double pos[3], const double R[9], float* out) const {
   const int n = robot_.depth_width * robot_.depth_height;
   const double range = robot_.depth_max_range;
   for (int i = 0; i < n; ++i) {
@@ -269,19 +274,9 @@ void World::depth_ray(int pixel, double pnt[3], double dir[3]) const {
 }
 
 void World::render_depth(float* out) const {
-  const double* R = module_mat(0);
   double pos[3];
   camera_pos(pos);
-  const int n = robot_.depth_width * robot_.depth_height;
-  const double range = robot_.depth_max_range;
-  for (int i = 0; i < n; ++i) {
-    const double* d = &ray_dirs_[3 * i];
-    double v[3];
-    for (int a = 0; a < 3; ++a) v[a] = R[3 * a] * d[0] + R[3 * a + 1] * d[1] + R[3 * a + 2] * d[2];
-    const double t = ray_scene(pos, v, range);
-    const double depth = t < 0 ? 1.0 : t * ray_forward_dot_[i] / range;
-    out[i] = float(std::clamp(depth, 0.01, 1.0));
-  }
+  cast_depth(pos, module_mat(0), out);
 }
 
 int World::render_view_from(double x, double y, double yaw, float* out) const {

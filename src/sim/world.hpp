@@ -96,6 +96,7 @@ class World {
   PerChain& chain(int modules);
   void bind(int modules);
   double ray_scene(const double pnt[3], const double dir[3], double max_dist) const;
+  void cast_depth(const double pos[3], const double R[9], float* out) const;
   void camera_pos(double pos[3]) const;
 
   RobotParams robot_;
