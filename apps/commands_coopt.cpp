@@ -30,23 +30,8 @@ using comorph::coopt::EpisodeLog;
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop = true; }
 
-comorph::report::EpisodeRecord to_record(const EpisodeLog& l) {
-  comorph::report::EpisodeRecord r;
-  r.episode = l.episode;
-  r.seed = l.seed;
-  r.scenario = l.scenario;
-  r.stair_height_m = l.stair_height_m;
-  r.obstacles = l.obstacles;
-  r.success = l.success;
-  r.termination = l.termination;
-  r.time_s = l.time_s;
-  r.energy_J = l.energy_J;
-  r.distance_fraction = l.distance_fraction;
-  r.return_R1 = l.return_R1;
-  r.configurations = l.configurations;
-  r.modules_total = l.modules_total;
-  return r;
-}
+// The report's columns of a log (the base part: EpisodeLog extends the record).
+const comorph::report::EpisodeRecord& to_record(const EpisodeLog& l) { return l; }
 
 // One CSV row in report's format (the writer's output without its header).
 void append_episode(const std::string& path, const EpisodeLog& log) {

@@ -34,27 +34,17 @@
 #include <vector>
 
 #include "coopt/config.hpp"
+#include "task/episode_record.hpp"
 
 namespace comorph::coopt {
 
 // One finished episode (training or evaluation). Mirrors report::EpisodeRecord
 // (the CLI converts), plus trainer diagnostics.
-struct EpisodeLog {
-  int episode = 0;                  // index within its run (training) or evaluation
-  std::uint64_t seed = 0;           // scene seed
-  std::string scenario;             // default | obstacles7 | obstacles8 | mixed
-  double stair_height_m = 0;        // m
-  int obstacles = 0;                // K in the flat area
-  bool success = false;             // reached the target
-  std::string termination;          // task::termination_name of the ending reason
-  double time_s = 0;                // simulated s
-  double energy_J = 0;              // J drawn by all modules
-  double distance_fraction = 0;     // D of Eq. 1, 0..1
-  double return_R1 = 0;             // summed R1 (Eq. 6)
+// The episode record of the report (task::EpisodeRecord) plus what only the
+// trainer knows.
+struct EpisodeLog : task::EpisodeRecord {
   double return_R2 = 0;             // summed R2 over the DQN's segments (Eq. 7); 0 in fixed mode
   double F = 0;                     // F(H) with the task's objective weights
-  std::vector<int> configurations;  // modules after each decision, consecutive repeats collapsed ("6->2")
-  int modules_total = 0;            // modules at the start
   int steps = 0;                    // control steps
   int switches = 0;                 // scene switches declared by the detector
   double stairs_energy_J = 0;       // E_c: J drawn while on the stairs (the R2 cost)

@@ -1,5 +1,4 @@
-// One line per episode: what the trainer and the evaluator log, what the
-// metrics and the training curves are computed from. No MuJoCo here.
+// CSV form of the episode records (task/episode_record.hpp).
 #pragma once
 
 #include <cstdint>
@@ -7,23 +6,11 @@
 #include <string>
 #include <vector>
 
+#include "task/episode_record.hpp"
+
 namespace comorph::report {
 
-struct EpisodeRecord {
-  int episode = 0;                 // episode index within its run (training or evaluation)
-  std::uint64_t seed = 0;          // seed the episode's scene was drawn from
-  std::string scenario;            // default | obstacles7 | obstacles8 | mixed | ...
-  double stair_height_m = 0;       // stair height of this episode, metres (0.04, 0.06, 0.08)
-  int obstacles = 0;               // obstacles in the flat area
-  bool success = false;            // reached the target
-  std::string termination;         // why it ended: success, collision, overturn, off_stairs, battery, timeout, ...
-  double time_s = 0;               // simulated time used, seconds
-  double energy_J = 0;             // energy drawn from all batteries, joules
-  double distance_fraction = 0;    // D: distance covered / initial distance to the target, 0..1
-  double return_R1 = 0;            // sum of the motion reward R1 (Eq. 6) over the episode
-  std::vector<int> configurations; // modules of each configuration chosen, in order (e.g. 4 then 2)
-  int modules_total = 0;           // modules (batteries) on board at the start of the episode
-};
+using task::EpisodeRecord;  // defined in task/episode_record.hpp
 
 // The CSV header, comma separated, in the order the columns are written.
 const std::vector<std::string>& episode_csv_columns();
