@@ -1,0 +1,232 @@
+// `comorph experiment --table 1|2 --config FILE --out runs/EXP`: every column
+// of the paper's Table I (hierarchy; fixed 2, 4, 6, 8, 10 modules) or Table II
+// (hierarchy with TD3 and with SAC; the TD3 hierarchy also on 7 and 8
+// obstacles and the mixed scene) as its own run directory under --out, then
+// the combined table beside the paper's and a full report.
+//
+// Resumable by running the same command again: a finished column is skipped,
+// an interrupted one resumes from its checkpoint, an evaluation whose
+// eval-<scenario>.json exists is not run again. Both tables may share one
+// --out: the hierarchical TD3 run is the same column in both.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "command_registry.hpp"
+#include "coopt/config.hpp"
+#include "coopt/trainer.hpp"
+#include "report/paper_reference.hpp"
+#include "report/report.hpp"
+#include "report/run_dir.hpp"
+#include "run_steps.hpp"
+
+namespace {
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// One column of a paper table: a run directory, the keys that make it that
+// column (applied after the user's --set), the test scenarios it is evaluated on.
+struct Column {
+  std::string name;
+  std::vector<std::string> sets;
+  std::vector<std::string> scenarios;
+};
+
+std::vector<Column> columns_of_table(int table) {
+  const std::vector<std::string> hierarchical_td3 = {"trainer.mode=hierarchical", "trainer.motion_algo=td3"};
+  if (table == 1) {
+    std::vector<Column> columns = {{"hier-td3", hierarchical_td3, {"default"}}};
+    for (int n = 2; n <= 10; n += 2)
+      columns.push_back({fmt::format("fixed-{}", n),
+                         {"trainer.mode=fixed", fmt::format("trainer.fixed_modules={}", n), "trainer.motion_algo=td3"},
+                         {"default"}});
+    return columns;
+  }
+  if (table == 2)
+    return {{"hier-td3", hierarchical_td3, {"default", "obstacles7", "obstacles8", "mixed"}},
+            {"hier-sac", {"trainer.mode=hierarchical", "trainer.motion_algo=sac"}, {"default"}}};
+  throw std::runtime_error(fmt::format("experiment: --table must be 1 or 2, got {}", table));
+}
+
+// Options of one `comorph experiment` call.
+struct ExperimentOptions {
+  int table = 0;
+  std::string config;
+  std::vector<std::string> sets;
+  std::string out;
+  std::string only;        // run just this column ("" = all)
+  int eval_episodes = 0;   // 0 = eval.episodes of the config
+};
+
+// What happened to one column in this call (for the closing summary).
+struct ColumnTimes {
+  std::string name;
+  std::string training;    // "trained", "resumed", "done before"
+  double train_wall_s = 0; // the run's whole training wall time (all resumed parts), s
+  long long env_steps = 0;
+  double eval_wall_s = 0;  // evaluations run in this call, s
+};
+
+// Makes sure the column's run is fully trained; false when interrupted.
+bool train_column(const ExperimentOptions& o, const Column& column, const std::string& run_dir, ColumnTimes& times) {
+  std::vector<std::string> sets = o.sets;
+  sets.insert(sets.end(), column.sets.begin(), column.sets.end());
+  const comorph::coopt::CooptConfig expected = comorph::coopt::load_coopt_config(o.config, sets);
+  const int total = expected.trainer.warmup_episodes + expected.trainer.episodes;
+
+  if (fs::exists(run_dir) && !fs::is_empty(run_dir)) {
+    const fs::path existing_config = fs::path(run_dir) / "config.yaml";
+    if (!fs::exists(existing_config))
+      throw std::runtime_error(run_dir + " exists and is not a training run (no config.yaml); move it away");
+    if (comorph::coopt::load_coopt_config(existing_config.string()).text != expected.text)
+      throw std::runtime_error(run_dir + " was trained with another configuration than --config/--set give now (" +
+                               existing_config.string() + "); use another --out or remove it");
+    bool has_checkpoint = true;
+    try {
+      comorph::coopt::read_checkpoint_info(run_dir);
+    } catch (const std::exception&) {
+      has_checkpoint = false;
+    }
+    if (!has_checkpoint) {
+      // Interrupted before its first checkpoint: nothing to resume.
+      std::fprintf(stderr, "experiment: %s has no checkpoint yet; starting it again\n", run_dir.c_str());
+      fs::remove_all(run_dir);
+    } else if (comorph::coopt::read_checkpoint_info(run_dir).episodes >= total) {
+      times.training = "done before";
+      return true;
+    } else {
+      times.training = "resumed";
+      return comorph::cli::train_run("", {}, "", run_dir);
+    }
+  }
+  times.training = "trained";
+  return comorph::cli::train_run(o.config, sets, run_dir, "");
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+}
+
+void run_experiment(const ExperimentOptions& o) {
+  std::vector<Column> columns = columns_of_table(o.table);
+  if (!o.only.empty()) {
+    std::vector<Column> picked;
+    std::string names;
+    for (const auto& c : columns) {
+      names += (names.empty() ? "" : ", ") + c.name;
+      if (c.name == o.only) picked.push_back(c);
+    }
+    if (picked.empty())
+      throw std::runtime_error(fmt::format("experiment: table {} has no column '{}' (columns: {})", o.table, o.only, names));
+    columns = picked;
+  }
+  // Every column's config is checked before hours of training start.
+  for (const auto& c : columns) {
+    std::vector<std::string> sets = o.sets;
+    sets.insert(sets.end(), c.sets.begin(), c.sets.end());
+    comorph::coopt::load_coopt_config(o.config, sets);
+  }
+  fs::create_directories(o.out);
+
+  std::vector<ColumnTimes> times;
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    const Column& column = columns[i];
+    const std::string run_dir = (fs::path(o.out) / column.name).string();
+    std::fprintf(stderr, "experiment: column %zu/%zu: %s\n", i + 1, columns.size(), run_dir.c_str());
+    ColumnTimes t;
+    t.name = column.name;
+    if (!train_column(o, column, run_dir, t)) {
+      std::fprintf(stderr, "experiment interrupted in %s (checkpoint written); run the same command again to continue\n",
+                   run_dir.c_str());
+      std::fflush(stderr);
+      std::exit(130);
+    }
+    const auto info = comorph::coopt::read_checkpoint_info(run_dir);
+    t.train_wall_s = info.wall_s;
+    t.env_steps = static_cast<long long>(info.env_steps);
+    for (const auto& scenario : column.scenarios) {
+      if (fs::exists(fs::path(run_dir) / ("eval-" + scenario + ".json"))) continue;
+      const auto start = Clock::now();
+      comorph::cli::eval_run(run_dir, scenario, o.eval_episodes, -1, 0);
+      t.eval_wall_s += std::chrono::duration<double>(Clock::now() - start).count();
+    }
+    times.push_back(t);
+  }
+
+  // The table of this experiment, ours beside the paper's, and the report,
+  // from every column directory of either table that is complete (a --only
+  // call, or one table of two, shows what exists so far).
+  std::vector<comorph::report::RunDir> runs;
+  std::vector<std::string> run_dirs;
+  for (const int table : {1, 2})
+    for (const auto& column : columns_of_table(table)) {
+      const std::string dir = (fs::path(o.out) / column.name).string();
+      if (std::find(run_dirs.begin(), run_dirs.end(), dir) != run_dirs.end()) continue;
+      try {
+        runs.push_back(comorph::report::load_run_dir(dir));
+        run_dirs.push_back(dir);
+      } catch (const std::exception&) {
+        // not trained or evaluated yet: its cells show "—"
+      }
+    }
+  const auto paper = comorph::report::load_paper_reference(comorph::report::default_paper_reference_path());
+  std::string table_md;
+  for (const auto& t : paper.tables) {
+    if (t.id != o.table) continue;
+    comorph::report::ReportBlock title;
+    title.kind = comorph::report::ReportBlock::Kind::Heading;
+    title.text = t.title + " (ours / paper)";
+    table_md = comorph::report::render_markdown({title, comorph::report::comparison_table(t, runs)});
+  }
+  const fs::path table_path = fs::path(o.out) / fmt::format("table-{}.md", o.table);
+  write_text(table_path, table_md);
+
+  std::printf("\n%s\n", table_md.c_str());
+  std::printf("%-10s %-12s %14s %14s %12s\n", "column", "training", "train wall s", "control steps", "eval wall s");
+  double train_total = 0, eval_total = 0;
+  for (const auto& t : times) {
+    std::printf("%-10s %-12s %14.0f %14lld %12.0f\n", t.name.c_str(), t.training.c_str(), t.train_wall_s, t.env_steps,
+                t.eval_wall_s);
+    train_total += t.train_wall_s;
+    eval_total += t.eval_wall_s;
+  }
+  std::printf("%-10s %-12s %14.0f %14s %12.0f  (training: all parts of each run; eval: this call only)\n", "total", "",
+              train_total, "", eval_total);
+
+  if (!run_dirs.empty()) {
+    comorph::report::ReportOptions report;
+    report.out_dir = (fs::path(o.out) / "report").string();
+    report.require_plots = false;
+    const auto written = comorph::report::write_report(run_dirs, report);
+    std::printf("wrote %s, %s and %s\n", table_path.c_str(), written.markdown_path.c_str(), written.html_path.c_str());
+  }
+}
+
+comorph::cli::CommandRegistration registration{[](CLI::App& app) {
+  auto* ex = app.add_subcommand(
+      "experiment", "train and evaluate every column of the paper's Table I or II, then the table beside the paper's");
+  static ExperimentOptions options;
+  ex->add_option("--table", options.table, "1: hierarchy vs fixed 2..10 modules; 2: TD3 vs SAC, 7/8 obstacles, mixed")
+      ->required();
+  ex->add_option("--config", options.config, "run config of every column (configs/quick.yaml, paper.yaml, ci.yaml)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  ex->add_option("--set", options.sets, "override a key of every column: --set trainer.episodes=100 (repeatable)");
+  ex->add_option("--out", options.out, "experiment directory: one run directory per column, table-N.md, report/")
+      ->required();
+  ex->add_option("--only", options.only, "run only this column (e.g. fixed-4); the table shows what exists");
+  ex->add_option("--eval-episodes", options.eval_episodes, "evaluation episodes per scenario (default: eval.episodes)");
+  ex->callback([] { run_experiment(options); });
+}};
+
+}  // namespace

@@ -1,0 +1,196 @@
+// train_run / eval_run (run_steps.hpp): what `comorph train`, `eval` and
+// `experiment` do to a run directory (docs/report.md: run.yaml, episodes.csv,
+// eval-<scenario>.json, plus config.yaml, evaluations.csv and checkpoint/).
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "run_steps.hpp"
+#include "coopt/config.hpp"
+#include "coopt/trainer.hpp"
+#include "report/episode_record.hpp"
+#include "report/metrics.hpp"
+#include "report/run_dir.hpp"
+#include "common/yaml_fields.hpp"
+
+namespace comorph::cli {
+namespace {
+namespace fs = std::filesystem;
+using comorph::coopt::CooptConfig;
+using comorph::coopt::EpisodeLog;
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop = true; }
+
+// The report's columns of a log (the base part: EpisodeLog extends the record).
+const comorph::report::EpisodeRecord& to_record(const EpisodeLog& l) { return l; }
+
+// One CSV row in report's format (the writer's output without its header).
+void append_episode(const std::string& path, const EpisodeLog& log) {
+  std::ostringstream s;
+  comorph::report::write_episodes_csv(s, {to_record(log)});
+  const std::string text = s.str();
+  std::ofstream out(path, std::ios::app);
+  out << text.substr(text.find('\n') + 1);
+  if (!out) throw std::runtime_error("cannot append to " + path);
+}
+
+// F(H) as the env defines it (task/rewards.hpp, env.task.objective in the config).
+const comorph::task::ObjectiveWeights& f_weights(const CooptConfig& c) { return c.env.task.objective; }
+
+const char* kEvalColumns =
+    "train_episode,env_steps,wall_s,episodes,success_0.04,success_0.06,success_0.08,success_avg,"
+    "mean_return_R1,mean_distance_fraction,mean_F,configurations\n";
+
+void append_evaluation(const std::string& path, const CooptConfig& c, const comorph::coopt::EvaluationLog& e) {
+  std::vector<comorph::report::EpisodeRecord> records;
+  double ret = 0, dist = 0;
+  for (const auto& l : e.episodes) {
+    records.push_back(to_record(l));
+    ret += l.return_R1;
+    dist += l.distance_fraction;
+  }
+  const auto m = comorph::report::summarize(records, f_weights(c));
+  const double n = static_cast<double>(e.episodes.size());
+  std::string configs;  // "0.04:4x2|6->2x1 0.06:..."
+  for (const auto& [height, seqs] : m.configurations) {
+    configs += (configs.empty() ? "" : " ") + height + ":";
+    bool first = true;
+    for (const auto& [seq, count] : seqs) {
+      configs += (first ? "" : "|") + seq + "x" + std::to_string(count);
+      first = false;
+    }
+  }
+  std::ofstream out(path, std::ios::app);
+  out << e.train_episode << ',' << e.env_steps << ',' << fmt::format("{:.1f}", e.wall_s) << ',' << e.episodes.size()
+      << ',' << format_rate(m.success_rate.at("0.04")) << ',' << format_rate(m.success_rate.at("0.06")) << ','
+      << format_rate(m.success_rate.at("0.08")) << ',' << format_rate(m.success_rate.at("avg")) << ','
+      << fmt::format("{:.2f}", ret / n) << ',' << fmt::format("{:.3f}", dist / n) << ','
+      << fmt::format("{:.3f}", m.F) << ',' << configs << '\n';
+  std::fprintf(stderr,
+               "evaluation after %d episodes: success 0.04/0.06/0.08 m = %s/%s/%s (avg %s), return %.1f, "
+               "distance %.0f %%, configurations %s\n",
+               e.train_episode, format_rate(m.success_rate.at("0.04")).c_str(), format_rate(m.success_rate.at("0.06")).c_str(),
+               format_rate(m.success_rate.at("0.08")).c_str(), format_rate(m.success_rate.at("avg")).c_str(), ret / n,
+               100.0 * dist / n, configs.c_str());
+}
+
+}  // namespace
+
+std::string format_rate(double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.2f}", v); }
+
+bool train_run(const std::string& config_path, const std::vector<std::string>& sets, const std::string& out,
+               const std::string& resume) {
+  std::string run_dir;
+  CooptConfig config;
+  if (!resume.empty()) {
+    if (!config_path.empty() || !sets.empty())
+      throw std::runtime_error("--resume takes the run's own config.yaml; drop --config/--set");
+    run_dir = resume;
+    const std::string path = (fs::path(run_dir) / "config.yaml").string();
+    if (!fs::exists(path)) throw std::runtime_error(run_dir + ": not a training run (no config.yaml)");
+    config = comorph::coopt::load_coopt_config(path);
+    comorph::coopt::read_checkpoint_info(run_dir);  // throws when there is no checkpoint
+  } else {
+    if (config_path.empty()) throw std::runtime_error("train: give --config FILE (or --resume runs/NAME)");
+    if (out.empty()) throw std::runtime_error("train: give --out runs/NAME");
+    config = comorph::coopt::load_coopt_config(config_path, sets);
+    if (fs::exists(out) && !fs::is_empty(out))
+      throw std::runtime_error(out + " exists and is not empty (use --resume " + out + " to continue it)");
+    run_dir = out;
+  }
+  const std::string episodes_csv = (fs::path(run_dir) / "episodes.csv").string();
+  const std::string evaluations_csv = (fs::path(run_dir) / "evaluations.csv").string();
+  comorph::coopt::TrainerCallbacks callbacks;
+  callbacks.on_episode = [&](const EpisodeLog& l) { append_episode(episodes_csv, l); };
+  callbacks.on_evaluation = [&](const comorph::coopt::EvaluationLog& e) {
+    append_evaluation(evaluations_csv, config, e);
+  };
+  // Everything that can fail on bad input happens before the directory exists.
+  comorph::coopt::Trainer trainer(config, run_dir, callbacks);
+
+  if (resume.empty()) {
+    fs::create_directories(run_dir);
+    std::ofstream(fs::path(run_dir) / "config.yaml") << config.text << "\n";
+    comorph::report::RunInfo info;
+    info.name = fs::path(run_dir).filename().string();
+    info.kind = config.trainer.mode;
+    info.modules = config.trainer.mode == "fixed" ? config.trainer.fixed_modules : comorph::coopt::kMaxModules;
+    info.algo = config.trainer.motion_algo;
+    info.scenario = config.trainer.scenario;
+    info.episodes = config.trainer.warmup_episodes + config.trainer.episodes;
+    info.preset = config.preset;
+    info.notes = "scene source: " + config.trainer.scene_source;
+    comorph::report::write_run_info((fs::path(run_dir) / "run.yaml").string(), info);
+    comorph::report::write_episodes_csv(episodes_csv, {});
+    std::ofstream(evaluations_csv) << kEvalColumns;
+  } else {
+    trainer.resume();
+    std::fprintf(stderr, "resuming %s after %d episodes (%lld control steps)\n", run_dir.c_str(),
+                 trainer.episodes_done(), static_cast<long long>(trainer.env_steps()));
+  }
+
+  g_stop = false;
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  const bool finished = trainer.run(&g_stop);
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  const double wall = trainer.wall_s();
+  std::fprintf(stderr, "%s %s: %d episodes, %lld control steps, %.0f s wall, %.0f steps/s\n",
+               finished ? "finished" : "interrupted, checkpoint written:", run_dir.c_str(), trainer.episodes_done(),
+               static_cast<long long>(trainer.env_steps()), wall, wall > 0 ? trainer.env_steps() / wall : 0.0);
+  return finished;
+}
+
+report::Metrics eval_run(const std::string& run_dir, const std::string& scenario, int episodes, int seed,
+                         int workers) {
+  const std::string path = (fs::path(run_dir) / "config.yaml").string();
+  if (!fs::exists(path)) throw std::runtime_error(run_dir + ": not a training run (no config.yaml)");
+  const CooptConfig config = comorph::coopt::load_coopt_config(path);
+  int obstacles = 0;
+  bool mixed = false;
+  comorph::coopt::scenario_settings(scenario, obstacles, mixed);  // throws on a bad name
+  comorph::coopt::EvalRequest request;
+  request.scenario = scenario;
+  request.episodes = episodes > 0 ? episodes : config.eval.episodes;
+  request.seed = seed >= 0 ? seed : config.eval.seed;
+  request.workers = workers > 0 ? workers : config.eval.workers;
+  const auto logs = comorph::coopt::evaluate(config, run_dir, request);
+
+  std::vector<comorph::report::EpisodeRecord> records;
+  for (const auto& l : logs) records.push_back(to_record(l));
+  const auto m = comorph::report::summarize(records, f_weights(config));
+  const std::string json = (fs::path(run_dir) / ("eval-" + scenario + ".json")).string();
+  const std::string csv = (fs::path(run_dir) / ("eval-" + scenario + "-episodes.csv")).string();
+  comorph::report::write_metrics_json(json, m);
+  comorph::report::write_episodes_csv(csv, records);
+
+  std::printf("%s, scenario %s: %d greedy episodes (seeds %d..%d)\n", run_dir.c_str(), scenario.c_str(),
+              request.episodes, request.seed, request.seed + request.episodes - 1);
+  std::printf("%-8s %-9s %s\n", "stairs", "success", "configurations (episodes)");
+  for (const std::string& key : comorph::report::paper_stair_keys()) {
+    std::string seqs;
+    if (m.configurations.count(key))
+      for (const auto& [seq, n] : m.configurations.at(key)) seqs += (seqs.empty() ? "" : ", ") + seq + " x" + std::to_string(n);
+    std::printf("%-8s %-9s %s\n", (key + " m").c_str(), format_rate(m.success_rate.at(key)).c_str(), seqs.c_str());
+  }
+  std::printf("%-8s %-9s\n", "avg", format_rate(m.success_rate.at("avg")).c_str());
+  std::printf("time %s s, energy %s J (means over successful episodes), F %.3f\n",
+              std::isnan(m.time_s) ? "-" : fmt::format("{:.1f}", m.time_s).c_str(),
+              std::isnan(m.energy_J) ? "-" : fmt::format("{:.0f}", m.energy_J).c_str(), m.F);
+  std::string terms;
+  for (const auto& [reason, n] : m.terminations) terms += (terms.empty() ? "" : ", ") + reason + " " + std::to_string(n);
+  std::printf("terminations: %s\nwrote %s and %s\n", terms.c_str(), json.c_str(), csv.c_str());
+  return m;
+}
+
+}  // namespace comorph::cli

@@ -1,0 +1,30 @@
+// The steps of a run directory's life, shared by `comorph train`, `eval` and
+// `experiment`: train (new or resumed) and evaluate. The run-directory layout
+// is docs/report.md's.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "report/metrics.hpp"
+
+namespace comorph::cli {
+
+// Trains a new run into `out` (config file + `--set`s) or, when `resume` is
+// given, continues that run from its last checkpoint. SIGINT/SIGTERM finish
+// the current episode and write a checkpoint; returns false then, true when
+// every episode is done.
+bool train_run(const std::string& config_path, const std::vector<std::string>& sets, const std::string& out,
+               const std::string& resume);
+
+// Greedy evaluation of a trained run on the paper's protocol: writes
+// eval-<scenario>.json and eval-<scenario>-episodes.csv into the run
+// directory and prints the summary. episodes/seed/workers <= 0 (seed < 0):
+// the run config's eval section.
+report::Metrics eval_run(const std::string& run_dir, const std::string& scenario, int episodes, int seed,
+                         int workers);
+
+// "0.53" or "-" for NaN (no episode of that kind).
+std::string format_rate(double value);
+
+}  // namespace comorph::cli

@@ -1,0 +1,84 @@
+// `comorph experiment` on the ci preset: every column of Table II becomes its
+// own run directory with its evaluations, the combined table holds our numbers
+// beside the paper's, a second call trains nothing again, and a call with a
+// changed configuration is refused instead of mixing two configurations.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+namespace fs = std::filesystem;
+
+const std::string kCi = std::string(COMORPH_SOURCE_DIR) + "/configs/ci.yaml";
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Runs `comorph args`; returns the exit status, stdout+stderr in `output`.
+int run_cli(const std::string& args, std::string& output) {
+  const fs::path log = fs::temp_directory_path() / ("comorph_apps_" + std::to_string(::getpid()) + ".log");
+  const int status = std::system((std::string(COMORPH_EXE) + " " + args + " > " + log.string() + " 2>&1").c_str());
+  output = read_file(log);
+  fs::remove(log);
+  return status;
+}
+
+TEST(Experiment, Table2TrainsEveryColumnWritesTheTableAndResumesWithoutRetraining) {
+  const fs::path out = fs::temp_directory_path() / ("comorph_experiment_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const std::string command =
+      "experiment --table 2 --config " + kCi + " --eval-episodes 3 --out " + out.string();
+  std::string log;
+  ASSERT_EQ(run_cli(command, log), 0) << log;
+
+  // Table II: the TD3 hierarchy (default, 7 and 8 obstacles, mixed) and the SAC hierarchy.
+  for (const char* f : {"hier-td3/eval-default.json", "hier-td3/eval-obstacles7.json", "hier-td3/eval-obstacles8.json",
+                        "hier-td3/eval-mixed.json", "hier-sac/eval-default.json", "table-2.md", "report/report.md",
+                        "report/report.html"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  EXPECT_FALSE(fs::exists(out / "fixed-2"));  // Table I's columns are not Table II's
+  EXPECT_NE(read_file(out / "hier-sac/run.yaml").find("algo: sac"), std::string::npos);
+  const std::string table = read_file(out / "table-2.md");
+  for (const char* cell : {"SAC, default [hier-sac]", "TD3, 8 obstacles [hier-td3]", "/ 3.24", "/ 89.3", "F(H)"})
+    EXPECT_NE(table.find(cell), std::string::npos) << cell << " not in\n" << table;
+  EXPECT_EQ(table.find("—"), std::string::npos) << "a column has no run:\n" << table;
+
+  // Again: nothing is trained or evaluated twice.
+  const std::string episodes = read_file(out / "hier-td3/episodes.csv");
+  const auto eval_time = fs::last_write_time(out / "hier-sac/eval-default.json");
+  ASSERT_EQ(run_cli(command, log), 0) << log;
+  EXPECT_NE(log.find("done before"), std::string::npos) << log;
+  EXPECT_EQ(read_file(out / "hier-td3/episodes.csv"), episodes);
+  EXPECT_EQ(fs::last_write_time(out / "hier-sac/eval-default.json"), eval_time);
+
+  // A changed configuration is refused, naming the column's directory.
+  EXPECT_NE(run_cli(command + " --set trainer.episodes=5", log), 0);
+  EXPECT_NE(log.find("another configuration"), std::string::npos) << log;
+  EXPECT_NE(log.find("hier-td3"), std::string::npos) << log;
+  fs::remove_all(out);
+}
+
+TEST(Experiment, BadTableOrColumnIsNamedBeforeAnyTraining) {
+  const fs::path out = fs::temp_directory_path() / ("comorph_experiment_bad_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  std::string log;
+  EXPECT_NE(run_cli("experiment --table 3 --config " + kCi + " --out " + out.string(), log), 0);
+  EXPECT_NE(log.find("--table must be 1 or 2"), std::string::npos) << log;
+  EXPECT_NE(run_cli("experiment --table 1 --only fixed-3 --config " + kCi + " --out " + out.string(), log), 0);
+  EXPECT_NE(log.find("fixed-4"), std::string::npos) << log;  // the message lists the columns
+  EXPECT_NE(run_cli("experiment --table 1 --set trainer.epsiodes=2 --config " + kCi + " --out " + out.string(), log), 0);
+  EXPECT_NE(log.find("trainer.epsiodes"), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace
