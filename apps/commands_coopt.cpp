@@ -33,7 +33,7 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   ev->add_option("--scenario", scenario, "default | obstacles7 | obstacles8 | mixed");
   ev->add_option("--episodes", episodes, "episodes (default: eval.episodes of the run's config)");
   ev->add_option("--seed", seed, "seed of episode 0 (episode i: seed + i; default: eval.seed)");
-  ev->add_option("--workers", workers, "threads (default: eval.workers); results do not depend on it");
+  ev->add_option("--workers", workers, "threads (default: eval.workers; 0 there = one per core); results do not depend on it");
   ev->callback([] { comorph::cli::eval_run(run, scenario, episodes, seed, workers); });
 }};
 

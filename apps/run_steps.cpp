@@ -1,6 +1,7 @@
 // train_run / eval_run (run_steps.hpp): what `comorph train`, `eval` and
 // `experiment` do to a run directory (docs/report.md: run.yaml, episodes.csv,
 // eval-<scenario>.json, plus config.yaml, evaluations.csv and checkpoint/).
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -10,6 +11,7 @@
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -164,6 +166,7 @@ report::Metrics eval_run(const std::string& run_dir, const std::string& scenario
   request.episodes = episodes > 0 ? episodes : config.eval.episodes;
   request.seed = seed >= 0 ? seed : config.eval.seed;
   request.workers = workers > 0 ? workers : config.eval.workers;
+  if (request.workers == 0) request.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const auto logs = comorph::coopt::evaluate(config, run_dir, request);
 
   std::vector<comorph::report::EpisodeRecord> records;

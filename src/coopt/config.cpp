@@ -152,7 +152,7 @@ EvalParams read_eval(const YAML::Node& n, const std::string& source) {
   YamlFields f(source);
   f.add("eval.episodes", &p.episodes, 1, 1000000);
   f.add("eval.seed", &p.seed, 0, 2000000000);
-  f.add("eval.workers", &p.workers, 1, 64);
+  f.add("eval.workers", &p.workers, 0, 256);
   f.apply(n, "eval.");
   return p;
 }

@@ -61,7 +61,7 @@ struct TrainerParams {
 struct EvalParams {
   int episodes = 30;     // greedy episodes; stair height of episode i = heights[i % 3]
   int seed = 700000;     // seed of episode i is seed + i
-  int workers = 2;       // threads, each with its own env and network copies
+  int workers = 2;       // threads, each with its own env and network copies; 0 = one per core
 };
 
 struct CooptConfig {

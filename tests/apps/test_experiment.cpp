@@ -52,6 +52,13 @@ TEST(Experiment, Table2TrainsEveryColumnWritesTheTableAndResumesWithoutRetrainin
   for (const char* cell : {"SAC, default [hier-sac]", "TD3, 8 obstacles [hier-td3]", "/ 3.24", "/ 89.3", "F(H)"})
     EXPECT_NE(table.find(cell), std::string::npos) << cell << " not in\n" << table;
   EXPECT_EQ(table.find("—"), std::string::npos) << "a column has no run:\n" << table;
+  // The report of the tiny runs: both tables, a section per run, the training curves.
+  const std::string report = read_file(out / "report/report.md");
+  for (const char* part : {"## Table I:", "## Table II:", "SAC, default [hier-sac]", "### hier-td3", "### hier-sac",
+                           "(training-curves.png)"})
+    EXPECT_NE(report.find(part), std::string::npos) << part << " not in the report";
+  ASSERT_TRUE(fs::exists(out / "report/training-curves.png"));
+  EXPECT_GT(fs::file_size(out / "report/training-curves.png"), 1000u);
 
   // Again: nothing is trained or evaluated twice.
   const std::string episodes = read_file(out / "hier-td3/episodes.csv");
