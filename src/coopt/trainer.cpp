@@ -165,9 +165,11 @@ control::MotionMode mode_of(int scene) {
   return scene == sim::kLabelStairs ? control::MotionMode::stair : control::MotionMode::flat;
 }
 
-// One episode; learn == hooks present. The env is reset here.
+// One episode; learn == hooks present. The env is reset here. `observe` (may
+// be null) sees the env after the reset that starts control and after every step.
 EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, SceneSource& scene,
-                task::EpisodeSpec spec, bool explore, const LearnHooks* hooks, Buffers& b) {
+                task::EpisodeSpec spec, bool explore, const LearnHooks* hooks, Buffers& b,
+                const StepObserver* observe = nullptr) {
   EpisodeLog log;
   const bool hierarchical = agent.config != nullptr;
   const bool image = c.trainer.motion_image;
@@ -195,6 +197,7 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
   spec.modules = modules;
   env.reset(spec);
   scene.reset(env);
+  if (observe) (*observe)(env);
   log.configurations.push_back(modules);
   log.modules_total = modules;
   Segment segment;
@@ -206,6 +209,7 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
   while (true) {
     agent.motion->act(b.obs, explore, b.action);
     r = &env.step(b.action.continuous.data(), mode_of(scene.current()));
+    if (observe) (*observe)(env);
     segment.add_step(r->reward, r->stairs_climbed_now);
     log.return_R1 += r->reward;
     fill_motion(env, image, b.next);
@@ -678,33 +682,61 @@ bool Trainer::run(const std::atomic<bool>* stop) {
 
 // ---------------------------------------------------------------------------
 
-std::vector<EpisodeLog> evaluate(const CooptConfig& config, const std::string& run_dir, const EvalRequest& request) {
-  const CheckpointInfo info = read_checkpoint_info(run_dir);
+namespace {
+
+// The run's checkpoint, refused when it was written by another configuration.
+// Also sets one torch thread per thread: evaluation threads run side by side
+// and their results must not depend on how many there are.
+CheckpointInfo open_checkpoint_for_evaluation(const CooptConfig& config, const std::string& run_dir) {
+  CheckpointInfo info = read_checkpoint_info(run_dir);
   if (info.config_text != config.text)
     throw std::runtime_error(run_dir + ": the checkpoint was written by another configuration (" +
                              first_difference(config.text, info.config_text) + ")");
   rl::set_torch_threads(1, 1);
+  return info;
+}
+
+// Greedy episodes of a trained run: one env, scene source and copy of both
+// networks (loaded from the checkpoint); one per evaluation thread.
+struct GreedyPlayer {
+  const CooptConfig& config;
+  task::MultiTaskEnv env;
+  SceneSource scene;
+  Agent agent;
+  Buffers buffers;
+
+  GreedyPlayer(const CooptConfig& c, const CheckpointInfo& checkpoint) : config(c), env(c.env), scene(c) {
+    agent.motion = make_motion(c, 1, true);
+    agent.motion->load((fs::path(checkpoint.directory) / "motion_actor.pt").string());
+    agent.config = make_config_model(c, 2);
+    if (agent.config) agent.config->load((fs::path(checkpoint.directory) / "config_model.pt").string());
+    allocate_buffers(c, buffers);
+  }
+
+  // Episode `index` of an evaluation of `scenario` (spec from eval_spec).
+  EpisodeLog play_episode(const std::string& scenario, const task::EpisodeSpec& spec, int index,
+                          const StepObserver* observe = nullptr) {
+    EpisodeLog log = play(config, agent, env, scene, spec, false, nullptr, buffers, observe);
+    log.episode = index;
+    log.scenario = scenario;
+    return log;
+  }
+};
+
+}  // namespace
+
+std::vector<EpisodeLog> evaluate(const CooptConfig& config, const std::string& run_dir, const EvalRequest& request) {
+  const CheckpointInfo info = open_checkpoint_for_evaluation(config, run_dir);
   std::vector<EpisodeLog> logs(static_cast<std::size_t>(request.episodes));
   std::atomic<int> next{0};
   std::mutex error_mutex;
   std::exception_ptr error;
   auto work = [&] {
     try {
-      task::MultiTaskEnv env(config.env);
-      SceneSource scene(config);
-      Agent agent;
-      agent.motion = make_motion(config, 1, true);
-      agent.motion->load((fs::path(info.directory) / "motion_actor.pt").string());
-      agent.config = make_config_model(config, 2);
-      if (agent.config) agent.config->load((fs::path(info.directory) / "config_model.pt").string());
-      Buffers b;
-      allocate_buffers(config, b);
+      GreedyPlayer player(config, info);
       for (int i = next++; i < request.episodes; i = next++) {
         const auto spec = eval_spec(config, request.scenario, static_cast<std::uint64_t>(request.seed) + i, i);
-        EpisodeLog log = play(config, agent, env, scene, spec, false, nullptr, b);
-        log.episode = i;
-        log.scenario = request.scenario;
-        logs[static_cast<std::size_t>(i)] = std::move(log);
+        logs[static_cast<std::size_t>(i)] = player.play_episode(request.scenario, spec, i);
       }
     } catch (...) {
       std::lock_guard<std::mutex> lock(error_mutex);
@@ -719,6 +751,22 @@ std::vector<EpisodeLog> evaluate(const CooptConfig& config, const std::string& r
   for (auto& th : threads) th.join();
   if (error) std::rethrow_exception(error);
   return logs;
+}
+
+EpisodeLog play_evaluation_episode(const CooptConfig& config, const std::string& run_dir,
+                                   const EvalEpisodeRequest& request, const StepObserver& observer) {
+  if (request.index < 0)
+    throw std::invalid_argument("play_evaluation_episode: episode index " + std::to_string(request.index) +
+                                " < 0 (the stair height cycle starts at episode 0)");
+  int obstacles = 0;
+  bool mixed = false;
+  scenario_settings(request.scenario, obstacles, mixed);  // a bad name throws before the checkpoint loads
+  const CheckpointInfo info = open_checkpoint_for_evaluation(config, run_dir);
+  GreedyPlayer player(config, info);
+  task::EpisodeSpec spec = eval_spec(config, request.scenario,
+                                     static_cast<std::uint64_t>(request.first_seed) + request.index, request.index);
+  if (request.stair_height_m > 0) spec.stair_height = request.stair_height_m;
+  return player.play_episode(request.scenario, spec, request.index, observer ? &observer : nullptr);
 }
 
 }  // namespace comorph::coopt

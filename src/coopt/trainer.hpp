@@ -36,6 +36,10 @@
 #include "coopt/config.hpp"
 #include "task/episode_record.hpp"
 
+namespace comorph::task {
+class MultiTaskEnv;  // task/multitask_env.hpp: what a StepObserver sees
+}
+
 namespace comorph::coopt {
 
 // One finished episode (training or evaluation). Mirrors report::EpisodeRecord
@@ -131,5 +135,23 @@ struct EvalRequest {
 // Loads run_dir/checkpoint; results are ordered by episode and do not depend on `workers`.
 std::vector<EpisodeLog> evaluate(const CooptConfig& config, const std::string& run_dir,
                                  const EvalRequest& request);
+
+// Sees the env after the reset that starts control and after every control
+// step (`comorph render` records the frames this way). It gets a const env, so
+// it cannot change the episode.
+using StepObserver = std::function<void(const task::MultiTaskEnv&)>;
+
+// One episode of an evaluation, replayed alone.
+struct EvalEpisodeRequest {
+  std::string scenario = "default";  // default | obstacles7 | obstacles8 | mixed
+  int first_seed = 700000;           // EvalRequest::seed of the evaluation
+  int index = 0;                     // episode i: seed first_seed + i, stair height heights[i % 3]
+  double stair_height_m = 0;         // > 0: this stair height instead (m)
+};
+// The same episode as evaluate(config, run_dir, {scenario, ..., first_seed})[index]
+// (identical log when stair_height_m is 0), with `observer` (may be empty)
+// called along the way. Loads run_dir/checkpoint as evaluate() does.
+EpisodeLog play_evaluation_episode(const CooptConfig& config, const std::string& run_dir,
+                                   const EvalEpisodeRequest& request, const StepObserver& observer);
 
 }  // namespace comorph::coopt
