@@ -42,10 +42,8 @@ class MultiTaskEnv;  // task/multitask_env.hpp: what a StepObserver sees
 
 namespace comorph::coopt {
 
-// One finished episode (training or evaluation). Mirrors report::EpisodeRecord
-// (the CLI converts), plus trainer diagnostics.
-// The episode record of the report (task::EpisodeRecord) plus what only the
-// trainer knows.
+// One finished episode (training or evaluation): the report's episode record
+// (task::EpisodeRecord) plus what only the trainer knows.
 struct EpisodeLog : task::EpisodeRecord {
   double return_R2 = 0;             // summed R2 over the DQN's segments (Eq. 7); 0 in fixed mode
   double F = 0;                     // F(H) with the task's objective weights
