@@ -6,32 +6,18 @@
 
 #include <unistd.h>
 
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
+
+#include "support/test_support.hpp"
 
 namespace {
 namespace fs = std::filesystem;
 
 const std::string kCi = std::string(COMORPH_SOURCE_DIR) + "/configs/ci.yaml";
 
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-// Runs `comorph args`; returns the exit status, stdout+stderr in `output`.
-int run_cli(const std::string& args, std::string& output) {
-  const fs::path log = fs::temp_directory_path() / ("comorph_apps_" + std::to_string(::getpid()) + ".log");
-  const int status = std::system((std::string(COMORPH_EXE) + " " + args + " > " + log.string() + " 2>&1").c_str());
-  output = read_file(log);
-  fs::remove(log);
-  return status;
-}
+using comorph::test_support::read_text;
+int run_cli(const std::string& args, std::string& output) { return comorph::test_support::run_comorph(args, output); }
 
 TEST(Experiment, Table2TrainsEveryColumnWritesTheTableAndResumesWithoutRetraining) {
   const fs::path out = fs::temp_directory_path() / ("comorph_experiment_" + std::to_string(::getpid()));
@@ -47,13 +33,13 @@ TEST(Experiment, Table2TrainsEveryColumnWritesTheTableAndResumesWithoutRetrainin
                         "report/report.html"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   EXPECT_FALSE(fs::exists(out / "fixed-2"));  // Table I's columns are not Table II's
-  EXPECT_NE(read_file(out / "hier-sac/run.yaml").find("algo: sac"), std::string::npos);
-  const std::string table = read_file(out / "table-2.md");
+  EXPECT_NE(read_text(out / "hier-sac/run.yaml").find("algo: sac"), std::string::npos);
+  const std::string table = read_text(out / "table-2.md");
   for (const char* cell : {"SAC, default [hier-sac]", "TD3, 8 obstacles [hier-td3]", "/ 3.24", "/ 89.3", "F(H)"})
     EXPECT_NE(table.find(cell), std::string::npos) << cell << " not in\n" << table;
   EXPECT_EQ(table.find("—"), std::string::npos) << "a column has no run:\n" << table;
   // The report of the tiny runs: both tables, a section per run, the training curves.
-  const std::string report = read_file(out / "report/report.md");
+  const std::string report = read_text(out / "report/report.md");
   for (const char* part : {"## Table I:", "## Table II:", "SAC, default [hier-sac]", "### hier-td3", "### hier-sac",
                            "(training-curves.png)"})
     EXPECT_NE(report.find(part), std::string::npos) << part << " not in the report";
@@ -61,11 +47,11 @@ TEST(Experiment, Table2TrainsEveryColumnWritesTheTableAndResumesWithoutRetrainin
   EXPECT_GT(fs::file_size(out / "report/training-curves.png"), 1000u);
 
   // Again: nothing is trained or evaluated twice.
-  const std::string episodes = read_file(out / "hier-td3/episodes.csv");
+  const std::string episodes = read_text(out / "hier-td3/episodes.csv");
   const auto eval_time = fs::last_write_time(out / "hier-sac/eval-default.json");
   ASSERT_EQ(run_cli(command, log), 0) << log;
   EXPECT_NE(log.find("done before"), std::string::npos) << log;
-  EXPECT_EQ(read_file(out / "hier-td3/episodes.csv"), episodes);
+  EXPECT_EQ(read_text(out / "hier-td3/episodes.csv"), episodes);
   EXPECT_EQ(fs::last_write_time(out / "hier-sac/eval-default.json"), eval_time);
 
   // A changed configuration is refused, naming the column's directory.

@@ -18,6 +18,7 @@
 #include "report/offscreen_renderer.hpp"
 #include "report/process.hpp"
 #include "report/render_episode.hpp"
+#include "support/test_support.hpp"
 #include "task/multitask_env.hpp"
 
 namespace comorph::coopt {
@@ -26,23 +27,8 @@ namespace fs = std::filesystem;
 
 const std::string kCi = std::string(COMORPH_SOURCE_DIR) + "/configs/ci.yaml";
 
-std::string temp_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("comorph_render_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p.string();
-}
-
-int run_cli(const std::string& args, std::string& output) {
-  const std::string log = fs::temp_directory_path() / ("comorph_render_cli_" + std::to_string(::getpid()) + ".log");
-  const int status = std::system((std::string(COMORPH_EXE) + " " + args + " > " + log + " 2>&1").c_str());
-  std::ifstream in(log);
-  std::ostringstream s;
-  s << in.rdbuf();
-  output = s.str();
-  fs::remove(log);
-  return status;
-}
+std::string temp_dir(const std::string& name) { return test_support::fresh_temp_dir("render_" + name); }
+int run_cli(const std::string& args, std::string& output) { return test_support::run_comorph(args, output); }
 
 // A ci-preset run trained by the command line (a few seconds), as a user has one.
 struct TrainedRun {

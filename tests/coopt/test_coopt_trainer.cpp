@@ -18,6 +18,7 @@
 #include "coopt/trainer.hpp"
 #include "perception/params.hpp"
 #include "perception/scene_classifier.hpp"
+#include "support/test_support.hpp"
 
 namespace comorph::coopt {
 namespace {
@@ -25,12 +26,7 @@ namespace fs = std::filesystem;
 
 const std::string kCi = std::string(COMORPH_SOURCE_DIR) + "/configs/ci.yaml";
 
-std::string temp_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("comorph_coopt_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p.string();
-}
+std::string temp_dir(const std::string& name) { return test_support::fresh_temp_dir("coopt_" + name); }
 
 // A log line with every field that a change of behaviour would move.
 std::string line_of(const EpisodeLog& l) {
@@ -289,16 +285,7 @@ TEST(Evaluate, GreedyEpisodesCycleHeightsAndDoNotDependOnWorkers) {
 
 // ---- the CLI: bad input stops before a run directory exists ----
 
-int run_cli(const std::string& args, std::string& err) {
-  const std::string log = fs::temp_directory_path() / ("comorph_cli_" + std::to_string(::getpid()) + ".log");
-  const int status = std::system((std::string(COMORPH_EXE) + " " + args + " > " + log + " 2>&1").c_str());
-  std::ifstream in(log);
-  std::ostringstream s;
-  s << in.rdbuf();
-  err = s.str();
-  fs::remove(log);
-  return status;
-}
+int run_cli(const std::string& args, std::string& output) { return test_support::run_comorph(args, output); }
 
 TEST(Cli, BadConfigOrSetFailsWithTheKeyAndCreatesNoRunDirectory) {
   const std::string parent = temp_dir("cli");
