@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -75,11 +76,17 @@ struct ColumnTimes {
   double eval_wall_s = 0;  // evaluations run in this call, s
 };
 
-// Makes sure the column's run is fully trained; false when interrupted.
-bool train_column(const ExperimentOptions& o, const Column& column, const std::string& run_dir, ColumnTimes& times) {
+// The user's --set list, then the column's keys.
+std::vector<std::string> column_sets(const ExperimentOptions& o, const Column& column) {
   std::vector<std::string> sets = o.sets;
   sets.insert(sets.end(), column.sets.begin(), column.sets.end());
-  const comorph::coopt::CooptConfig expected = comorph::coopt::load_coopt_config(o.config, sets);
+  return sets;
+}
+
+// Makes sure the column's run is fully trained; false when interrupted.
+// `expected` is the column's config (--config + column_sets).
+bool train_column(const ExperimentOptions& o, const Column& column, const comorph::coopt::CooptConfig& expected,
+                  const std::string& run_dir, ColumnTimes& times) {
   const int total = expected.trainer.warmup_episodes + expected.trainer.episodes;
 
   if (fs::exists(run_dir) && !fs::is_empty(run_dir)) {
@@ -89,17 +96,17 @@ bool train_column(const ExperimentOptions& o, const Column& column, const std::s
     if (comorph::coopt::load_coopt_config(existing_config.string()).text != expected.text)
       throw std::runtime_error(run_dir + " was trained with another configuration than --config/--set give now (" +
                                existing_config.string() + "); use another --out or remove it");
-    bool has_checkpoint = true;
+    std::optional<comorph::coopt::CheckpointInfo> checkpoint;
     try {
-      comorph::coopt::read_checkpoint_info(run_dir);
+      checkpoint = comorph::coopt::read_checkpoint_info(run_dir);
     } catch (const std::exception&) {
-      has_checkpoint = false;
+      // no complete checkpoint: handled below
     }
-    if (!has_checkpoint) {
+    if (!checkpoint) {
       // Interrupted before its first checkpoint: nothing to resume.
       std::fprintf(stderr, "experiment: %s has no checkpoint yet; starting it again\n", run_dir.c_str());
       fs::remove_all(run_dir);
-    } else if (comorph::coopt::read_checkpoint_info(run_dir).episodes >= total) {
+    } else if (checkpoint->episodes >= total) {
       times.training = "done before";
       return true;
     } else {
@@ -108,7 +115,7 @@ bool train_column(const ExperimentOptions& o, const Column& column, const std::s
     }
   }
   times.training = "trained";
-  return comorph::cli::train_run(o.config, sets, run_dir, "");
+  return comorph::cli::train_run(o.config, column_sets(o, column), run_dir, "");
 }
 
 void write_text(const fs::path& path, const std::string& text) {
@@ -131,11 +138,8 @@ void run_experiment(const ExperimentOptions& o) {
     columns = picked;
   }
   // Every column's config is checked before hours of training start.
-  for (const auto& c : columns) {
-    std::vector<std::string> sets = o.sets;
-    sets.insert(sets.end(), c.sets.begin(), c.sets.end());
-    comorph::coopt::load_coopt_config(o.config, sets);
-  }
+  std::vector<comorph::coopt::CooptConfig> configs;
+  for (const auto& c : columns) configs.push_back(comorph::coopt::load_coopt_config(o.config, column_sets(o, c)));
   fs::create_directories(o.out);
 
   std::vector<ColumnTimes> times;
@@ -145,7 +149,7 @@ void run_experiment(const ExperimentOptions& o) {
     std::fprintf(stderr, "experiment: column %zu/%zu: %s\n", i + 1, columns.size(), run_dir.c_str());
     ColumnTimes t;
     t.name = column.name;
-    if (!train_column(o, column, run_dir, t)) {
+    if (!train_column(o, column, configs[i], run_dir, t)) {
       std::fprintf(stderr, "experiment interrupted in %s (checkpoint written); run the same command again to continue\n",
                    run_dir.c_str());
       std::fflush(stderr);

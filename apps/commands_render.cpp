@@ -100,12 +100,6 @@ struct RenderRequest {
   comorph::report::RenderOptions options;
 };
 
-std::string join_configurations(const std::vector<int>& modules) {
-  std::string s;
-  for (int m : modules) s += (s.empty() ? "" : "->") + std::to_string(m);
-  return s;
-}
-
 void render_run(RenderRequest r, bool seed_given, bool stair_height_given) {
   // Everything that can fail on bad input fails before the episode runs.
   const std::string config_path = (fs::path(r.run_dir) / "config.yaml").string();
@@ -157,12 +151,12 @@ void render_run(RenderRequest r, bool seed_given, bool stair_height_given) {
               log.stair_height_m, log.obstacles);
   std::printf("outcome: %s after %.2f s (%d control steps), energy %.0f J, configurations %s (%.1f s wall)\n",
               log.termination.c_str(), log.time_s, log.steps, log.energy_J,
-              join_configurations(log.configurations).c_str(), episode_s);
+              comorph::task::configuration_sequence(log.configurations).c_str(), episode_s);
 
   // Strip beside the video, and in the run directory where `comorph report`
   // picks up render*.png (named after what makes the episode).
   r.options.video_path = r.out;
-  r.options.strip_path = fs::path(r.out).replace_extension().string() + "-strip.png";
+  r.options.strip_path = comorph::report::strip_path_beside(r.out);
   r.options.camera.track_body = "module1";  // the chain's root body: the robot stays centred
   r.options.video.fps = 1.0 / (config.env.robot.control_period * r.frame_step);
   std::string run_strip = fmt::format("render-{}", r.seed);

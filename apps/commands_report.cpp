@@ -18,14 +18,6 @@
 
 namespace {
 
-// `--out x.mp4` -> x-strip.png beside it.
-std::string strip_path_for(const std::string& video) {
-  const auto dot = video.rfind('.');
-  const auto slash = video.rfind('/');
-  const bool has_ext = dot != std::string::npos && (slash == std::string::npos || dot > slash);
-  return (has_ext ? video.substr(0, dot) : video) + "-strip.png";
-}
-
 comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   // --- report ---
   auto* report = app.add_subcommand(
@@ -97,7 +89,7 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
                           ? steps_per_frame
                           : std::max(1, static_cast<int>(1.0 / (ropt.video.fps * model->opt.timestep) + 0.5));
     ropt.video_path = out;
-    ropt.strip_path = strip_path_for(out);
+    ropt.strip_path = comorph::report::strip_path_beside(out);
     ropt.max_frames = frames;
     const auto result = comorph::report::render_episode(
         model.get(), data.get(),

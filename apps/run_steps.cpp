@@ -29,6 +29,9 @@ namespace fs = std::filesystem;
 using comorph::coopt::CooptConfig;
 using comorph::coopt::EpisodeLog;
 
+// "0.53", or "-" for NaN (no episode of that kind).
+std::string format_rate(double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.2f}", v); }
+
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop = true; }
 
@@ -86,8 +89,6 @@ void append_evaluation(const std::string& path, const CooptConfig& c, const como
 }
 
 }  // namespace
-
-std::string format_rate(double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.2f}", v); }
 
 bool train_run(const std::string& config_path, const std::vector<std::string>& sets, const std::string& out,
                const std::string& resume) {

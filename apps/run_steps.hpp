@@ -24,7 +24,4 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
 report::Metrics eval_run(const std::string& run_dir, const std::string& scenario, int episodes, int seed,
                          int workers);
 
-// "0.53" or "-" for NaN (no episode of that kind).
-std::string format_rate(double value);
-
 }  // namespace comorph::cli

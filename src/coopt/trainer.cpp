@@ -588,8 +588,7 @@ struct Trainer::Impl {
     rate /= static_cast<double>(recent_success.size());
     const double w = wall();
     const double eta_s = episode > 0 ? w / episode * (total - episode) : 0;
-    std::string configs;
-    for (int m : log.configurations) configs += (configs.empty() ? "" : "->") + std::to_string(m);
+    const std::string configs = task::configuration_sequence(log.configurations);
     std::fprintf(stderr,
                  "episode %d/%d%s | %d steps, return %.1f, %s | total %lld steps, %.0f steps/s | success %.0f %% "
                  "(last %zu) | config %s (stairs %.2f m) | wall %.0f s, ETA %.0f s\n",

@@ -82,10 +82,6 @@ const std::vector<std::string>& episode_csv_columns() {
   return columns;
 }
 
-std::string configuration_sequence(const std::vector<int>& configurations) {
-  return fmt::format("{}", fmt::join(configurations, "->"));
-}
-
 void write_episodes_csv(std::ostream& out, const std::vector<EpisodeRecord>& records) {
   out << fmt::format("{}\n", fmt::join(episode_csv_columns(), ","));
   for (const auto& r : records) {

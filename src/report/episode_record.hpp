@@ -28,7 +28,6 @@ void write_episodes_csv(const std::string& path, const std::vector<EpisodeRecord
 std::vector<EpisodeRecord> read_episodes_csv(std::istream& in, const std::string& source_name);
 std::vector<EpisodeRecord> read_episodes_csv(const std::string& path);
 
-// "4->2" for {4, 2}; "" for none.
-std::string configuration_sequence(const std::vector<int>& configurations);
+using task::configuration_sequence;  // "4->2" for {4, 2}
 
 }  // namespace comorph::report

@@ -1,11 +1,16 @@
 #include "report/render_episode.hpp"
 
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
 namespace comorph::report {
+
+std::string strip_path_beside(const std::string& video_path) {
+  return std::filesystem::path(video_path).replace_extension().string() + "-strip.png";
+}
 
 std::vector<int> evenly_spaced(int total, int count) {
   std::vector<int> out;

@@ -50,6 +50,9 @@ RenderResult render_episode(const std::function<std::optional<SimFrame>()>& next
 RenderResult render_episode(const mjModel* model, mjData* data, const std::function<bool()>& advance,
                             const RenderOptions& options);
 
+// Where the keyframe strip of a video goes: "runs/x/ep.mp4" -> "runs/x/ep-strip.png".
+std::string strip_path_beside(const std::string& video_path);
+
 // Picks `count` items spread evenly from `total` (first and last included),
 // as indices in increasing order; all of them when total <= count.
 std::vector<int> evenly_spaced(int total, int count);

@@ -8,27 +8,15 @@ namespace comorph::rl {
 DqnConfig DqnConfig::from_yaml(const YAML::Node& node, const std::string& source) {
   DqnConfig c;
   YamlFields f(source);
-  f.add("gamma", &c.gamma);
+  add_shared_learner_fields(f, c);
   f.add("learning_rate", &c.learning_rate);
   f.add("adam_epsilon", &c.adam_epsilon);
-  f.add("batch_size", &c.batch_size);
-  f.add("buffer_size", &c.buffer_size);
-  f.add("learning_starts", &c.learning_starts);
-  f.add("train_frequency", &c.train_frequency);
-  f.add("gradient_steps", &c.gradient_steps);
   f.add("target_update_interval", &c.target_update_interval);
-  f.add("tau", &c.tau);
   f.add("epsilon_start", &c.epsilon_start);
   f.add("epsilon_end", &c.epsilon_end);
   f.add("epsilon_decay", &c.epsilon_decay);
   f.add("loss", &c.loss);
-  f.add("max_grad_norm", &c.max_grad_norm);
   f.add("double_dqn", &c.double_dqn);
-  f.add("hidden_sizes", &c.hidden_sizes);
-  f.add("image_features", &c.image_features);
-  f.add("image_fc_size", &c.image_fc_size);
-  f.add("image_storage", &c.image_storage);
-  f.add("device", &c.device);
   f.apply(node);
   if (c.loss != "huber" && c.loss != "mse")
     throw std::invalid_argument(source + ": field \"loss\" must be huber or mse, got \"" + c.loss + "\"");

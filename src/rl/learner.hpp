@@ -78,6 +78,25 @@ std::string rl_config_dir();
 // (Declared with a string to keep torch out of this header.)
 void check_device_name(const std::string& name);
 
+// The fields every learner's config has (DqnConfig, Td3Config, SacConfig), bound
+// under one set of YAML names; each from_yaml adds its own fields next to these.
+template <class LearnerConfig>
+void add_shared_learner_fields(YamlFields& f, LearnerConfig& c) {
+  f.add("gamma", &c.gamma);
+  f.add("batch_size", &c.batch_size);
+  f.add("buffer_size", &c.buffer_size);
+  f.add("learning_starts", &c.learning_starts);
+  f.add("train_frequency", &c.train_frequency);
+  f.add("gradient_steps", &c.gradient_steps);
+  f.add("tau", &c.tau);
+  f.add("max_grad_norm", &c.max_grad_norm);
+  f.add("hidden_sizes", &c.hidden_sizes);
+  f.add("image_features", &c.image_features);
+  f.add("image_fc_size", &c.image_fc_size);
+  f.add("image_storage", &c.image_storage);
+  f.add("device", &c.device);
+}
+
 // Sets the intra-op and inter-op thread counts of torch. The inter-op count
 // can only be set once per process; later calls leave it alone.
 void set_torch_threads(int intra_op_threads, int inter_op_threads);

@@ -9,32 +9,20 @@ namespace comorph::rl {
 SacConfig SacConfig::from_yaml(const YAML::Node& node, const std::string& source) {
   SacConfig c;
   YamlFields f(source);
-  f.add("gamma", &c.gamma);
+  add_shared_learner_fields(f, c);
   f.add("actor_learning_rate", &c.actor_learning_rate);
   f.add("critic_learning_rate", &c.critic_learning_rate);
   f.add("alpha_learning_rate", &c.alpha_learning_rate);
-  f.add("batch_size", &c.batch_size);
-  f.add("buffer_size", &c.buffer_size);
-  f.add("learning_starts", &c.learning_starts);
   f.add("random_action_steps", &c.random_action_steps);
   f.add("random_action_episodes", &c.random_action_episodes);
-  f.add("train_frequency", &c.train_frequency);
-  f.add("gradient_steps", &c.gradient_steps);
   f.add("policy_frequency", &c.policy_frequency);
   f.add("target_network_frequency", &c.target_network_frequency);
-  f.add("tau", &c.tau);
   f.add("alpha", &c.alpha);
   f.add("autotune_alpha", &c.autotune_alpha);
   f.add("target_entropy_scale", &c.target_entropy_scale);
   f.add("log_std_min", &c.log_std_min);
   f.add("log_std_max", &c.log_std_max);
-  f.add("max_grad_norm", &c.max_grad_norm);
-  f.add("hidden_sizes", &c.hidden_sizes);
-  f.add("image_features", &c.image_features);
-  f.add("image_fc_size", &c.image_fc_size);
   f.add("share_encoder", &c.share_encoder);
-  f.add("image_storage", &c.image_storage);
-  f.add("device", &c.device);
   f.apply(node);
   if (c.batch_size <= 0 || c.buffer_size <= 0 || c.train_frequency <= 0 ||
       c.policy_frequency <= 0 || c.target_network_frequency <= 0)

@@ -9,31 +9,19 @@ namespace comorph::rl {
 Td3Config Td3Config::from_yaml(const YAML::Node& node, const std::string& source) {
   Td3Config c;
   YamlFields f(source);
-  f.add("gamma", &c.gamma);
+  add_shared_learner_fields(f, c);
   f.add("actor_learning_rate", &c.actor_learning_rate);
   f.add("critic_learning_rate", &c.critic_learning_rate);
-  f.add("batch_size", &c.batch_size);
-  f.add("buffer_size", &c.buffer_size);
-  f.add("learning_starts", &c.learning_starts);
   f.add("random_action_steps", &c.random_action_steps);
   f.add("random_action_episodes", &c.random_action_episodes);
-  f.add("train_frequency", &c.train_frequency);
-  f.add("gradient_steps", &c.gradient_steps);
   f.add("policy_delay", &c.policy_delay);
-  f.add("tau", &c.tau);
   f.add("policy_noise", &c.policy_noise);
   f.add("noise_clip", &c.noise_clip);
   f.add("exploration_noise_start", &c.exploration_noise_start);
   f.add("exploration_noise_end", &c.exploration_noise_end);
   f.add("exploration_noise_decay", &c.exploration_noise_decay);
   f.add("exploration_noise_unit", &c.exploration_noise_unit);
-  f.add("max_grad_norm", &c.max_grad_norm);
-  f.add("hidden_sizes", &c.hidden_sizes);
-  f.add("image_features", &c.image_features);
-  f.add("image_fc_size", &c.image_fc_size);
   f.add("share_encoder", &c.share_encoder);
-  f.add("image_storage", &c.image_storage);
-  f.add("device", &c.device);
   f.apply(node);
   if (c.exploration_noise_unit != "transitions" && c.exploration_noise_unit != "episodes")
     throw std::invalid_argument(source + ": field \"exploration_noise_unit\" must be transitions "

@@ -25,4 +25,12 @@ struct EpisodeRecord {
   int modules_total = 0;           // modules (batteries) on board at the start of the episode
 };
 
+// "4->2" for {4, 2}; "" for none: how logs, progress lines and reports name a
+// sequence of configurations.
+inline std::string configuration_sequence(const std::vector<int>& configurations) {
+  std::string s;
+  for (int modules : configurations) s += (s.empty() ? "" : "->") + std::to_string(modules);
+  return s;
+}
+
 }  // namespace comorph::task
