@@ -46,6 +46,15 @@ struct RobotParams {
   double depth_pitch = 0.25;      // rad, camera looks down by this much
   double depth_max_range = 4.0;   // m, depth 1.0 at this distance; values clipped to [0.01, 1]
   double camera_height = 0.11;    // m above ground, at module 1's front face
+  // Decision camera: the same camera position, read only when the configuration
+  // model decides (2-3 times an episode). Narrower and aimed at the stairs, so
+  // that 0.02 m of stair height is several rows, not one (at the start the first
+  // riser is 0.5 m away: its top edge is 0.04 rad lower per 0.02 m of height).
+  int decision_depth_width = 32;      // pixels
+  int decision_depth_height = 32;     // pixels
+  double decision_fov_y = 0.45;       // rad, vertical field of view
+  double decision_fov_x = 0.9;        // rad, horizontal field of view
+  double decision_pitch = 0.03;       // rad, looks down by this much
   double distance_range = 1.0;    // m, left/right distance sensors saturate at 1.0 here
   double distance_height = 0.08;  // m above ground
   // ---- energy ----

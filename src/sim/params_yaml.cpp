@@ -38,6 +38,11 @@ RobotParams robot_params_from_yaml(const std::string& text, const std::string& s
   f.add("depth_fov_x", &p.depth_fov_x, 0.05, 3.0);
   f.add("depth_pitch", &p.depth_pitch, -1.5, 1.5);
   f.add("depth_max_range", &p.depth_max_range, 0.1, 100);
+  f.add("decision_depth_width", &p.decision_depth_width, 1, 256);
+  f.add("decision_depth_height", &p.decision_depth_height, 1, 256);
+  f.add("decision_fov_y", &p.decision_fov_y, 0.05, 3.0);
+  f.add("decision_fov_x", &p.decision_fov_x, 0.05, 3.0);
+  f.add("decision_pitch", &p.decision_pitch, -1.5, 1.5);
   f.add("camera_height", &p.camera_height, 0.0, 1.0);
   f.add("distance_range", &p.distance_range, 0.05, 20);
   f.add("distance_height", &p.distance_height, 0.0, 1.0);

@@ -26,15 +26,21 @@ World::World(const RobotParams& robot, const SceneParams& scene, std::shared_ptr
   install_quiet_mujoco_warnings();
   if (!cache_) cache_ = std::make_shared<ModelCache>(robot_, scene_);
   substeps_ = int(std::lround(robot_.control_period / robot_.physics_timestep));
-  // Depth rays: pinhole grid, row 0 at the top, column 0 at the left.
-  const int w = robot_.depth_width, h = robot_.depth_height;
-  ray_dirs_.resize(std::size_t(3) * w * h);
-  ray_forward_dot_.resize(std::size_t(w) * h);
-  const double p = robot_.depth_pitch;
+  rays_ = make_rays(robot_.depth_width, robot_.depth_height, robot_.depth_fov_x, robot_.depth_fov_y,
+                    robot_.depth_pitch);
+  decision_rays_ = make_rays(robot_.decision_depth_width, robot_.decision_depth_height, robot_.decision_fov_x,
+                             robot_.decision_fov_y, robot_.decision_pitch);
+}
+
+World::RaySet World::make_rays(int w, int h, double fov_x, double fov_y, double p) {
+  // Pinhole grid, row 0 at the top, column 0 at the left.
+  RaySet r;
+  r.dirs.resize(std::size_t(3) * w * h);
+  r.forward_dot.resize(std::size_t(w) * h);
   const double fwd[3] = {std::cos(p), 0, -std::sin(p)};
   const double up[3] = {std::sin(p), 0, std::cos(p)};
   const double left[3] = {0, 1, 0};
-  const double tx = std::tan(0.5 * robot_.depth_fov_x), ty = std::tan(0.5 * robot_.depth_fov_y);
+  const double tx = std::tan(0.5 * fov_x), ty = std::tan(0.5 * fov_y);
   for (int i = 0; i < h; ++i)
     for (int j = 0; j < w; ++j) {
       const double u = (1.0 - 2.0 * (j + 0.5) / w) * tx;  // + left
@@ -43,9 +49,10 @@ World::World(const RobotParams& robot, const SceneParams& scene, std::shared_ptr
       for (int a = 0; a < 3; ++a) d[a] = fwd[a] + u * left[a] + v * up[a];
       const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
       const std::size_t px = std::size_t(i) * w + j;
-      for (int a = 0; a < 3; ++a) ray_dirs_[3 * px + a] = d[a] / n;
-      ray_forward_dot_[px] = 1.0 / n;
+      for (int a = 0; a < 3; ++a) r.dirs[3 * px + a] = d[a] / n;
+      r.forward_dot[px] = 1.0 / n;
     }
+  return r;
 }
 
 World::PerChain& World::chain(int modules) {
@@ -242,19 +249,19 @@ void World::render_depth_at(const double pos[3], double yaw, double pitch, float
   const double cy = std::cos(yaw), sy = std::sin(yaw), cp = std::cos(pitch), sp = std::sin(pitch);
   const double R[9] = {cy * cp, -sy, -cy * sp, sy * cp, cy, -sy * sp, sp, 0, cp};
   // Columns: x axis (cy cp, sy cp, sp), y axis (-sy, cy, 0), z axis (-cy sp, -sy sp, cp).
-  cast_depth(pos, R, out);
+  cast_depth(rays_, pos, R, out);
 }
 
 // One depth image from a camera at `pos` whose carrier frame is the row-major rotation `R`.
-void World::cast_depth(const double pos[3], const double R[9], float* out) const {
-  const int n = robot_.depth_width * robot_.depth_height;
+void World::cast_depth(const RaySet& rays, const double pos[3], const double R[9], float* out) const {
+  const int n = static_cast<int>(rays.forward_dot.size());
   const double range = robot_.depth_max_range;
   for (int i = 0; i < n; ++i) {
-    const double* d = &ray_dirs_[3 * i];
+    const double* d = &rays.dirs[3 * i];
     double v[3];
     for (int a = 0; a < 3; ++a) v[a] = R[3 * a] * d[0] + R[3 * a + 1] * d[1] + R[3 * a + 2] * d[2];
     const double t = ray_scene(pos, v, range);
-    const double depth = t < 0 ? 1.0 : t * ray_forward_dot_[i] / range;
+    const double depth = t < 0 ? 1.0 : t * rays.forward_dot[i] / range;
     out[i] = float(std::clamp(depth, 0.01, 1.0));
   }
 }
@@ -269,14 +276,20 @@ void World::camera_pos(double pos[3]) const {
 void World::depth_ray(int pixel, double pnt[3], double dir[3]) const {
   camera_pos(pnt);
   const double* R = module_mat(0);
-  const double* d = &ray_dirs_[3 * std::size_t(pixel)];
+  const double* d = &rays_.dirs[3 * std::size_t(pixel)];
   for (int a = 0; a < 3; ++a) dir[a] = R[3 * a] * d[0] + R[3 * a + 1] * d[1] + R[3 * a + 2] * d[2];
 }
 
 void World::render_depth(float* out) const {
   double pos[3];
   camera_pos(pos);
-  cast_depth(pos, module_mat(0), out);
+  cast_depth(rays_, pos, module_mat(0), out);
+}
+
+void World::render_decision_depth(float* out) const {
+  double pos[3];
+  camera_pos(pos);
+  cast_depth(decision_rays_, pos, module_mat(0), out);
 }
 
 int World::render_view_from(double x, double y, double yaw, float* out) const {

@@ -51,6 +51,9 @@ class World {
   // Depth image from module 1's camera, row-major depth_height x depth_width,
   // planar depth / depth_max_range clipped to [0.01, 1] (1 = nothing in range).
   void render_depth(float* out) const;
+  // The decision camera (RobotParams::decision_*) at module 1's camera position:
+  // decision_depth_height x decision_depth_width, same depth encoding.
+  void render_decision_depth(float* out) const;
   // The same camera placed at an arbitrary pose: the camera's position (m, scene
   // frame) and the heading (yaw, rad) and pitch-up (rad) of the module carrying it.
   void render_depth_at(const double pos[3], double yaw, double pitch, float* out) const;
@@ -96,7 +99,13 @@ class World {
   PerChain& chain(int modules);
   void bind(int modules);
   double ray_scene(const double pnt[3], const double dir[3], double max_dist) const;
-  void cast_depth(const double pos[3], const double R[9], float* out) const;
+  // Pinhole ray grid of one camera, in the camera-carrier frame (x forward, y left, z up).
+  struct RaySet {
+    std::vector<double> dirs;         // unit directions, 3 per pixel, row 0 at the top
+    std::vector<double> forward_dot;  // dir . optical axis, for planar depth
+  };
+  static RaySet make_rays(int width, int height, double fov_x, double fov_y, double pitch);
+  void cast_depth(const RaySet& rays, const double pos[3], const double R[9], float* out) const;
   void camera_pos(double pos[3]) const;
 
   RobotParams robot_;
@@ -113,9 +122,8 @@ class World {
   int first_obstacle_geom_ = -1, first_step_geom_ = -1, target_geom_ = -1, floor_geom_ = -1;
   std::array<double, kMaxChain> energy_{};
   double shed_energy_ = 0;  // J drawn by modules that were shed
-  // Depth rays in the camera-carrier frame (x forward, y left, z up), unit length.
-  std::vector<double> ray_dirs_;
-  std::vector<double> ray_forward_dot_;  // dir . optical axis, for planar depth
+  RaySet rays_;           // the motion camera (depth_*)
+  RaySet decision_rays_;  // the decision camera (decision_*)
 };
 
 const char* instability_name(Instability i);

@@ -218,3 +218,35 @@ TEST(Stability, NanStateIsReportedNotHidden) {
   w.mutable_data()->qvel[0] = std::nan("");
   EXPECT_NE(w.step_control(hold.data()).instability, Instability::none);
 }
+
+// The configuration model decides at the start, 0.5 m before the first riser.
+// Rows (of the centre column) whose depth changes between 0.04 m and 0.08 m
+// stairs: the decision camera must show the height as several rows, the wide
+// motion camera shows it as about one per riser.
+int rows_that_see_the_height(const RobotParams& rp, bool decision) {
+  const SceneParams sp = quiet_scene();
+  const int w = decision ? rp.decision_depth_width : rp.depth_width;
+  const int h = decision ? rp.decision_depth_height : rp.depth_height;
+  std::vector<float> low(std::size_t(w) * h), high(low.size());
+  World world(rp, sp);
+  for (auto [height, out] : {std::pair{0.04, &low}, std::pair{0.08, &high}}) {
+    world.reset(empty_layout(sp, height), 4);
+    if (decision)
+      world.render_decision_depth(out->data());
+    else
+      world.render_depth(out->data());
+  }
+  int rows = 0;
+  for (int i = 0; i < h; ++i) rows += std::abs(low[std::size_t(i) * w + w / 2] - high[std::size_t(i) * w + w / 2]) > 0.01f;
+  return rows;
+}
+
+TEST(Sensors, DecisionCameraShowsTheStairHeightAsSeveralRows) {
+  const RobotParams rp;
+  const int decision_rows = rows_that_see_the_height(rp, true);
+  const int motion_rows = rows_that_see_the_height(rp, false);
+  std::printf("rows that differ between 0.04 and 0.08 m stairs: decision camera %d of %d, motion camera %d of %d\n",
+              decision_rows, rp.decision_depth_height, motion_rows, rp.depth_height);
+  EXPECT_GE(decision_rows, 8);
+  EXPECT_GE(decision_rows, 2 * motion_rows);
+}
