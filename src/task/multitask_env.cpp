@@ -23,7 +23,16 @@ const char* termination_name(Termination t) {
 
 MultiTaskEnv::MultiTaskEnv(const EnvConfig& config, std::shared_ptr<sim::ModelCache> cache)
     : config_(config), world_(config.robot, config.scene, std::move(cache)) {
-  depth_.assign(std::size_t(config_.robot.depth_width) * config_.robot.depth_height, 1.0f);
+  const sim::RobotParams& r = config_.robot;
+  depth_.assign(std::size_t(r.depth_width) * r.depth_height, 1.0f);
+  clearance_.assign(std::size_t(r.depth_width), 1.0f);
+  // Row i's centre looks atan(v_i) - pitch above the horizon (World's pinhole grid).
+  horizon_rows_ = 0;
+  for (int i = 0; i < r.depth_height; ++i) {
+    const double v = (1.0 - 2.0 * (i + 0.5) / r.depth_height) * std::tan(0.5 * r.depth_fov_y);
+    if (std::atan(v) > r.depth_pitch) horizon_rows_ = i + 1;
+  }
+  horizon_rows_ = std::max(horizon_rows_, 1);
 }
 
 void MultiTaskEnv::reset(const EpisodeSpec& spec) {
@@ -173,6 +182,12 @@ void MultiTaskEnv::reconfigure(int modules) {
 void MultiTaskEnv::update_observation() {
   const int n = world_.modules();
   world_.render_depth(depth_.data());
+  const int w = depth_width();
+  for (int j = 0; j < w; ++j) {
+    float nearest = 1.0f;
+    for (int i = 0; i < horizon_rows_; ++i) nearest = std::min(nearest, depth_[std::size_t(i) * w + j]);
+    clearance_[std::size_t(j)] = nearest;
+  }
   world_.read_distances(distances_.data());
   const double* head = world_.module_pos(0);
   label_ = sim::scene_label(config_.scene, world_.layout(), head[0], head[1]);

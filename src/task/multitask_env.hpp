@@ -101,6 +101,16 @@ class MultiTaskEnv {
   int depth_width() const { return config_.robot.depth_width; }
   int depth_height() const { return config_.robot.depth_height; }
   const float* state() const { return state_.data(); }  // obs::kStateSize floats
+  // What is straight ahead: per depth-image column, the nearest depth over the
+  // rows that look above the horizon (they never see the floor a robot stands
+  // on, so only obstacles, risers, the target post or 1 = nothing within range).
+  // depth_width() floats in [0.01, 1], column 0 at the left.
+  const float* clearance() const { return clearance_.data(); }
+  // The decision camera's image (decision_depth_height() x decision_depth_width()),
+  // rendered on request: the configuration model reads it only when it decides.
+  void render_decision_depth(float* out) const { world_.render_decision_depth(out); }
+  int decision_depth_width() const { return config_.robot.decision_depth_width; }
+  int decision_depth_height() const { return config_.robot.decision_depth_height; }
   int scene_label() const { return label_; }           // sim::SceneLabel of module 1's position
 
   // ---- episode bookkeeping for R2 and evaluation ----
@@ -134,6 +144,8 @@ class MultiTaskEnv {
   control::MotorCommand command_;
   std::array<double, 4 * sim::kMaxChain> ctrl_{};
   std::vector<float> depth_;
+  std::vector<float> clearance_;
+  int horizon_rows_ = 1;  // depth rows whose centre looks above the horizon (level camera)
   std::array<float, obs::kStateSize> state_{};
   std::array<float, control::kActionSize> prev_action_{};
   std::array<float, 2 * sim::kMaxChain> distances_{};

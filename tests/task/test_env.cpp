@@ -238,3 +238,22 @@ TEST(Env, LabelledViewsForTheSceneClassifier) {
   env.world().render_view_from(-0.8, 0.0, 0.0, ground.data());
   EXPECT_NE(img, ground);
 }
+
+// clearance(): per column, the nearest depth among the rows that look above the
+// horizon. At the start (camera 0.11 m up, 0.5 m before the first riser) with
+// 0.08 m steps, riser 2 (top 0.16 m, 0.9 m ahead) rises into those rows; with
+// 0.04 m steps and no obstacles nothing does (the floor and the low risers stay
+// below the horizon), so every column reads 1 = nothing within range.
+TEST(Env, ClearanceSeesWhatRisesAboveTheCameraStraightAhead) {
+  const task::EnvConfig c;
+  task::MultiTaskEnv env(c);
+  const int w = c.robot.depth_width;
+  env.reset(spec(3, 4, 0.08, 0));
+  EXPECT_NEAR(env.clearance()[w / 2] * c.robot.depth_max_range, 0.9, 0.06);
+  env.reset(spec(3, 4, 0.04, 0));
+  for (int j = 0; j < w; ++j) EXPECT_FLOAT_EQ(env.clearance()[j], 1.0f) << "column " << j;
+  // The floor is in the image, just not in the clearance row.
+  float nearest = 1.0f;
+  for (int i = 0; i < c.robot.depth_height; ++i) nearest = std::min(nearest, env.depth()[i * w + w / 2]);
+  EXPECT_LT(nearest, 0.1f);
+}
