@@ -45,6 +45,7 @@ struct Observation {
 struct Action {
   int discrete = -1;              // index in [0, size) for discrete actions
   std::vector<float> continuous;  // size values in [-1, 1] for continuous actions
+  bool demonstration = false;     // chosen by a demonstrator (scripted pilot), not by the learner
 };
 
 struct StepResult {

@@ -39,6 +39,7 @@ ReplayBuffer::ReplayBuffer(ObservationSpec observation, ActionSpec action, std::
   reward_ = torch::zeros({capacity}, f32);
   discount_ = torch::zeros({capacity}, f32);
   terminated_ = torch::zeros({capacity}, f32);
+  demonstration_ = torch::zeros({capacity}, f32);
 }
 
 void ReplayBuffer::store_image(const std::vector<float>& image, torch::Tensor& storage,
@@ -97,6 +98,7 @@ void ReplayBuffer::add(const Observation& obs, const Action& action, float rewar
   reward_.data_ptr<float>()[slot] = reward;
   discount_.data_ptr<float>()[slot] = discount;
   terminated_.data_ptr<float>()[slot] = terminated ? 1.0f : 0.0f;
+  demonstration_.data_ptr<float>()[slot] = action.demonstration ? 1.0f : 0.0f;
   position_ = (position_ + 1) % capacity_;
   size_ = std::min(size_ + 1, capacity_);
 }
@@ -123,6 +125,7 @@ ReplayBatch ReplayBuffer::gather(const torch::Tensor& slots, const torch::Device
   b.bootstrap = (discount_.index_select(0, slots) * (1.0f - terminated_.index_select(0, slots)))
                     .to(device);
   if (next_valid_.defined()) b.next_valid_actions = next_valid_.index_select(0, slots).to(device);
+  b.demonstration = demonstration_.index_select(0, slots).to(device);
   return b;
 }
 
@@ -157,6 +160,7 @@ void ReplayBuffer::save(torch::serialize::OutputArchive& a) const {
   a.write("reward", filled(reward_));
   a.write("discount", filled(discount_));
   a.write("terminated", filled(terminated_));
+  a.write("demonstration", filled(demonstration_));
   if (next_valid_.defined()) a.write("next_valid", filled(next_valid_));
 }
 
@@ -195,6 +199,14 @@ void ReplayBuffer::load(torch::serialize::InputArchive& a) {
   restore("reward", reward_);
   restore("discount", discount_);
   restore("terminated", terminated_);
+  demonstration_.zero_();
+  {  // absent in buffers saved before demonstrations existed: none were
+    torch::Tensor src;
+    if (a.try_read("demonstration", src)) {
+      if (src.size(0) != size_) throw std::runtime_error("ReplayBuffer::load: field \"demonstration\" has the wrong shape");
+      demonstration_.slice(0, 0, size_).copy_(src);
+    }
+  }
   if (next_valid_.defined()) restore("next_valid", next_valid_);
 }
 

@@ -22,6 +22,8 @@ Td3Config Td3Config::from_yaml(const YAML::Node& node, const std::string& source
   f.add("exploration_noise_decay", &c.exploration_noise_decay);
   f.add("exploration_noise_unit", &c.exploration_noise_unit);
   f.add("share_encoder", &c.share_encoder);
+  f.add("bc_weight", &c.bc_weight, 0.0, 1000.0);
+  f.add("bc_decay_updates", &c.bc_decay_updates, std::int64_t(0), std::int64_t(1) << 40);
   f.apply(node);
   if (c.exploration_noise_unit != "transitions" && c.exploration_noise_unit != "episodes")
     throw std::invalid_argument(source + ": field \"exploration_noise_unit\" must be transitions "
@@ -64,6 +66,12 @@ double Td3::exploration_noise() const {
   return LinearSchedule{config_.exploration_noise_start, config_.exploration_noise_end,
                         config_.exploration_noise_decay}
       .at(t);
+}
+
+double Td3::bc_weight_now() const {
+  if (config_.bc_decay_updates <= 0) return config_.bc_weight;
+  return LinearSchedule{config_.bc_weight, 0.0, static_cast<double>(config_.bc_decay_updates)}.at(
+      static_cast<double>(counters_.updates));
 }
 
 torch::Tensor Td3::gaussian(std::int64_t rows, std::int64_t cols, double std) {
@@ -146,7 +154,18 @@ void Td3::update() {
     // learns from the critic loss only).
     const torch::Tensor critic_f = f.detach();
     const torch::Tensor actor_f = nets_->actor_features(b.image, b.vector, critic_f);
-    const torch::Tensor actor_loss = -nets_->q1(critic_f, torch::tanh(nets_->actor_head(actor_f))).mean();
+    const torch::Tensor pi = torch::tanh(nets_->actor_head(actor_f));
+    const torch::Tensor q = nets_->q1(critic_f, pi);
+    torch::Tensor actor_loss;
+    if (config_.bc_weight > 0) {
+      // Q normalised by its batch magnitude, so that w means the same at any reward scale.
+      const double w = bc_weight_now();
+      actor_loss = -q.mean() / q.abs().mean().detach().clamp_min(1e-6);
+      if (w > 0)
+        actor_loss = actor_loss + w * ((pi - b.action).pow(2).sum(1) * b.demonstration).mean();
+    } else {
+      actor_loss = -q.mean();
+    }
     actor_optimizer_->zero_grad();
     actor_loss.backward();
     if (config_.max_grad_norm > 0)

@@ -40,6 +40,12 @@ struct Td3Config {
   double exploration_noise_decay = 0;    // decay length; 0 = constant `end`
   std::string exploration_noise_unit = "transitions";  // decay counted in "transitions" or "episodes"
   double max_grad_norm = 0;              // clip gradient L2 norms; 0 = off
+  // Behaviour cloning on demonstrated transitions (TD3+BC, Fujimoto & Gu 2021):
+  // actor loss = -Q / mean|Q| + w * (squared error to the demonstrated action on
+  // demonstration samples). w falls linearly from bc_weight to 0 over
+  // bc_decay_updates actor updates (0 = constant). bc_weight 0 = plain TD3.
+  double bc_weight = 0;
+  std::int64_t bc_decay_updates = 0;
   std::vector<int> hidden_sizes{256, 256};  // actor and critic MLP hidden layers
   int image_features = 16;               // CNN output size (paper: 16)
   int image_fc_size = 256;               // the CNN's hidden FC layer
@@ -67,6 +73,7 @@ class Td3 final : public Learner {
   double last_loss() const override { return last_loss_; }
 
   double exploration_noise() const;
+  double bc_weight_now() const;  // w of the behaviour-cloning term at the current update
   const Td3Config& config() const { return config_; }
   ActorCritic& networks() { return nets_; }
   ActorCritic& target_networks() { return target_; }

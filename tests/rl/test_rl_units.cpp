@@ -381,6 +381,65 @@ TEST(Td3, ExplorationNoiseDecaysPerEpisode) {
   EXPECT_NEAR(td3.exploration_noise(), 0.02, 1e-12);
 }
 
+// Behaviour cloning: every transition ends with reward 1 whatever the action,
+// so the critic learns a flat Q and gives the actor no direction; only the BC term on the demonstrated transitions can move it to
+// the demonstrated action (0.7 where x > 0, -0.4 where x < 0). Without it the
+// actor stays where the initialisation put it. Non-demonstrated transitions
+// with other actions must not pull it.
+double bc_error_after_training(double bc_weight) {
+  rl::Td3Config c;
+  c.hidden_sizes = {32, 32};
+  c.batch_size = 64;
+  c.buffer_size = 1000;
+  c.learning_starts = 0;
+  c.random_action_steps = 0;
+  c.policy_delay = 1;
+  c.actor_learning_rate = 3e-3;
+  c.bc_weight = bc_weight;
+  rl::Td3 td3({0, 0, 0, 1}, 1, c, 3);
+  rl::Action a;
+  for (int i = 0; i < 400; ++i) {
+    const float x = static_cast<float>(i % 20) / 10.0f - 0.95f;
+    a.demonstration = i % 2 == 0;
+    a.continuous = {a.demonstration ? (x > 0 ? 0.7f : -0.4f) : 0.9f * (i % 3 == 0 ? 1.0f : -1.0f)};
+    td3.store(vector_obs({x}), a, 1.0f, vector_obs({x}), true, false);
+  }
+  for (int u = 0; u < 800; ++u) td3.update();
+  double error = 0;
+  for (float x : {-0.8f, -0.3f, 0.3f, 0.8f}) {
+    td3.act(vector_obs({x}), false, a);
+    error += std::abs(a.continuous[0] - (x > 0 ? 0.7f : -0.4f));
+  }
+  return error / 4;
+}
+
+TEST(Td3, BehaviourCloningPullsTheActorToTheDemonstratedActions) {
+  const double with_bc = bc_error_after_training(2.5);
+  const double without = bc_error_after_training(0.0);
+  std::printf("mean |pi(x) - demonstrated| after 800 updates: with BC %.3f, without %.3f\n", with_bc, without);
+  EXPECT_LT(with_bc, 0.1);
+  EXPECT_GT(without, 0.2);
+}
+
+TEST(ReplayBuffer, KeepsTheDemonstrationFlagThroughSaveAndLoad) {
+  rl::ReplayBuffer buffer({0, 0, 0, 1}, {rl::ActionKind::kContinuous, 1}, 4);
+  rl::Action a;
+  a.continuous = {0.1f};
+  for (int i = 0; i < 3; ++i) {
+    a.demonstration = i == 1;
+    buffer.add(vector_obs({float(i)}), a, 0.0f, vector_obs({0}), false, 0.99f);
+  }
+  const std::string path = temp_path("replay_demo.pt");
+  buffer.save(path);
+  rl::ReplayBuffer restored({0, 0, 0, 1}, {rl::ActionKind::kContinuous, 1}, 4);
+  restored.load(path);
+  const rl::ReplayBatch b = restored.gather(torch::arange(3), torch::kCPU);
+  EXPECT_EQ(b.demonstration[0].item<float>(), 0.0f);
+  EXPECT_EQ(b.demonstration[1].item<float>(), 1.0f);
+  EXPECT_EQ(b.demonstration[2].item<float>(), 0.0f);
+  std::filesystem::remove(path);
+}
+
 // ---- hyperparameter files -----------------------------------------------------------
 
 TEST(Config, EveryPresetLoadsAndUnknownFieldsAreRejected) {
