@@ -98,13 +98,16 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   check_keys(n, source, pre,
              {"mode", "fixed_modules", "motion_algo", "seed", "warmup_episodes", "episodes", "sync_interval",
               "learner_thread", "torch_threads", "motion_image", "config_vector", "scene_source",
+              "motion_clearance", "normalize_state", "decision_camera", "warmup_policy", "warmup_noise",
+              "scripted_interval",
               "classifier_dir", "scenario", "stair_height", "eval_interval", "eval_episodes", "eval_seed",
               "checkpoint_interval", "progress_interval", "env_dir"});
   if (!n || n.IsNull()) return p;
   // Numbers with ranges through YamlFields (names the key and the range).
   YamlFields f(source);
   YAML::Node numbers(YAML::NodeType::Map);
-  const std::vector<std::string> strings{"mode", "motion_algo", "scene_source", "classifier_dir", "scenario", "env_dir"};
+  const std::vector<std::string> strings{"mode",     "motion_algo", "scene_source", "classifier_dir",
+                                         "scenario", "env_dir",     "warmup_policy"};
   for (const auto& kv : n) {
     const std::string k = kv.first.as<std::string>();
     bool is_string = false;
@@ -120,6 +123,11 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   f.add(pre + ".torch_threads", &p.torch_threads, 1, 64);
   f.add(pre + ".motion_image", &p.motion_image);
   f.add(pre + ".config_vector", &p.config_vector);
+  f.add(pre + ".motion_clearance", &p.motion_clearance);
+  f.add(pre + ".normalize_state", &p.normalize_state);
+  f.add(pre + ".decision_camera", &p.decision_camera);
+  f.add(pre + ".warmup_noise", &p.warmup_noise, 0.0, 2.0);
+  f.add(pre + ".scripted_interval", &p.scripted_interval, 0, 10000000);
   f.add(pre + ".stair_height", &p.stair_height, 0, 0.5);
   f.add(pre + ".eval_interval", &p.eval_interval, 0, 10000000);
   f.add(pre + ".eval_episodes", &p.eval_episodes, 1, 100000);
@@ -132,11 +140,13 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
                                                                : s == "scene_source" ? p.scene_source
                                                                : s == "classifier_dir" ? p.classifier_dir
                                                                : s == "scenario" ? p.scenario
+                                                               : s == "warmup_policy" ? p.warmup_policy
                                                                                  : p.env_dir);
   one_of(source, pre + ".mode", p.mode, {"hierarchical", "fixed"});
   one_of(source, pre + ".motion_algo", p.motion_algo, {"td3", "sac"});
   one_of(source, pre + ".scene_source", p.scene_source, {"ground_truth", "classifier"});
   one_of(source, pre + ".scenario", p.scenario, {"default", "obstacles7", "obstacles8", "mixed"});
+  one_of(source, pre + ".warmup_policy", p.warmup_policy, {"random", "scripted"});
   if (p.scene_source == "classifier") {
     if (p.classifier_dir.empty())
       fail(source, pre + ".classifier_dir", "scene_source: classifier needs the directory of a trained classifier");

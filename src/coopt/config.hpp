@@ -44,7 +44,17 @@ struct TrainerParams {
   bool learner_thread = true;         // false: run the updates inline (one core, same results)
   int torch_threads = 1;              // torch intra-op threads per thread (1: small nets, reproducible)
   bool motion_image = true;           // the motion model sees the depth image (CNN) + state; false: state only
+  bool motion_clearance = false;      // the motion model also sees task's clearance(): nearest depth per image column
+  bool normalize_state = false;       // scale the state vector's fields to about [-1, 1] (fixed factors, trainer.cpp)
   bool config_vector = true;          // the DQN sees [C_n / 10, scene one-hot x3] beside the depth image
+  bool decision_camera = false;       // the DQN sees the decision camera (env.robot.decision_*), not the motion camera
+  // Who drives the motion during the warm-up: "random" (uniform actions, the
+  // paper) or "scripted" (task::ScriptedPilot, which plans on the true obstacle
+  // layout, plus Gaussian noise): demonstrations in the replay, marked as such.
+  // The models never see what the pilot knows; they learn from its transitions.
+  std::string warmup_policy = "random";
+  double warmup_noise = 0.2;          // std of the noise on the pilot's actions (action units)
+  int scripted_interval = 0;          // after the warm-up, every this-many-th episode is the pilot's too (0 = none)
   std::string scene_source = "ground_truth";  // ground_truth (simulator labels) | classifier (ResNet-18 on depth)
   std::string classifier_dir;         // trained classifier directory (scene_source: classifier)
   std::string scenario = "default";   // training scene: default | obstacles7 | obstacles8 | mixed

@@ -24,6 +24,7 @@
 #include "rl/td3.hpp"
 #include "sim/scene.hpp"
 #include "task/multitask_env.hpp"
+#include "task/scripted_pilot.hpp"
 
 namespace comorph::coopt {
 namespace fs = std::filesystem;
@@ -42,15 +43,15 @@ rl::ObservationSpec motion_spec(const CooptConfig& c) {
     s.image_height = c.env.robot.depth_height;
     s.image_width = c.env.robot.depth_width;
   }
-  s.vector_size = task::obs::kStateSize;
+  s.vector_size = task::obs::kStateSize + (c.trainer.motion_clearance ? c.env.robot.depth_width : 0);
   return s;
 }
 
 rl::ObservationSpec config_spec(const CooptConfig& c) {
   rl::ObservationSpec s;
   s.image_channels = 1;
-  s.image_height = c.env.robot.depth_height;
-  s.image_width = c.env.robot.depth_width;
+  s.image_height = c.trainer.decision_camera ? c.env.robot.decision_depth_height : c.env.robot.depth_height;
+  s.image_width = c.trainer.decision_camera ? c.env.robot.decision_depth_width : c.env.robot.depth_width;
   s.vector_size = c.trainer.config_vector ? kConfigVector : 0;
   return s;
 }
@@ -136,6 +137,11 @@ struct LearnHooks {
   std::function<void(const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool, int)>
       config;
   std::function<int(const std::vector<std::uint8_t>&)> random_config;  // warm-up choice, -1 = ask the DQN
+  // Demonstrations: when set, the pilot drives (its action + Gaussian noise of
+  // std pilot_noise from pilot_rng) instead of the motion model's action.
+  task::ScriptedPilot* pilot = nullptr;
+  double pilot_noise = 0;
+  std::mt19937_64* pilot_rng = nullptr;
 };
 
 // Reusable buffers of an episode runner (no allocation in the step loop).
@@ -145,14 +151,43 @@ struct Buffers {
   std::vector<std::uint8_t> mask;
 };
 
-void fill_motion(const task::MultiTaskEnv& env, bool image, rl::Observation& o) {
-  if (image) std::copy(env.depth(), env.depth() + o.image.size(), o.image.begin());
-  std::copy(env.state(), env.state() + task::obs::kStateSize, o.vector.begin());
+// Fixed factors that bring the state's fields to about [-1, 1] (trainer.normalize_state):
+// positions over the 6 m area, speeds up to 0.4 m/s, R1 per step about 1.3 at full
+// speed, the goal up to 6.5 m away, the mode index 0..2.
+float state_scale(int i) {
+  namespace o = task::obs;
+  if (i == o::kPosition || i == o::kPosition + 1) return 0.2f;
+  if (i == o::kPosition + 2) return 5.0f;
+  if (i == o::kVelocity || i == o::kVelocity + 1) return 2.5f;
+  if (i == o::kPrevReward) return 0.5f;
+  if (i == o::kGoal + 2) return 0.2f;
+  if (i == o::kMode) return 0.5f;
+  return 1.0f;
 }
 
-void fill_config(const task::MultiTaskEnv& env, int max_modules, int scene, bool vector, Buffers& b,
+// The motion model's vector: the state (scaled if asked), then the clearance row if asked.
+void fill_motion(const task::MultiTaskEnv& env, const TrainerParams& t, rl::Observation& o) {
+  if (t.motion_image) std::copy(env.depth(), env.depth() + o.image.size(), o.image.begin());
+  const float* state = env.state();
+  for (int i = 0; i < task::obs::kStateSize; ++i) {
+    float v = state[i];
+    if (t.normalize_state) {
+      if (i == task::obs::kPrevReward) v = std::clamp(v, -10.0f, 10.0f);
+      v *= state_scale(i);
+    }
+    o.vector[static_cast<std::size_t>(i)] = v;
+  }
+  if (t.motion_clearance)
+    std::copy(env.clearance(), env.clearance() + env.depth_width(), o.vector.begin() + task::obs::kStateSize);
+}
+
+void fill_config(const task::MultiTaskEnv& env, const TrainerParams& t, int max_modules, int scene, Buffers& b,
                  rl::Observation& o) {
-  std::copy(env.depth(), env.depth() + o.image.size(), o.image.begin());
+  const bool vector = t.config_vector;
+  if (t.decision_camera)
+    env.render_decision_depth(o.image.data());
+  else
+    std::copy(env.depth(), env.depth() + o.image.size(), o.image.begin());
   if (vector) {
     o.vector[0] = static_cast<float>(max_modules) / kMaxModules;
     for (int k = 0; k < 3; ++k) o.vector[1 + k] = scene == k ? 1.0f : 0.0f;
@@ -172,7 +207,7 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
                 const StepObserver* observe = nullptr) {
   EpisodeLog log;
   const bool hierarchical = agent.config != nullptr;
-  const bool image = c.trainer.motion_image;
+  const TrainerParams& t = c.trainer;
   int modules = c.trainer.fixed_modules;
   double return_r2 = 0;
   auto choose = [&](rl::Observation& o) {
@@ -191,12 +226,14 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
     spec.modules = kMaxModules;
     env.reset(spec);
     scene.reset(env);
-    fill_config(env, kMaxModules, scene.current(), c.trainer.config_vector, b, b.cobs);
+    fill_config(env, t, kMaxModules, scene.current(), b, b.cobs);
     modules = choose(b.cobs);
   }
   spec.modules = modules;
   env.reset(spec);
   scene.reset(env);
+  task::ScriptedPilot* pilot = hooks ? hooks->pilot : nullptr;
+  if (pilot) pilot->plan(env);
   if (observe) (*observe)(env);
   log.configurations.push_back(modules);
   log.modules_total = modules;
@@ -204,15 +241,24 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
   segment.begin(false, 0.0);
 
   // 2. Control steps.
-  fill_motion(env, image, b.obs);
+  fill_motion(env, t, b.obs);
   const task::StepResult* r = nullptr;
+  std::int64_t saturated = 0;
   while (true) {
-    agent.motion->act(b.obs, explore, b.action);
+    agent.motion->act(b.obs, explore, b.action);  // also when the pilot drives: the same RNG stream
+    b.action.demonstration = pilot != nullptr;
+    if (pilot) {
+      control::MotionMode pilot_mode;
+      pilot->act(env, b.action.continuous.data(), pilot_mode);
+      std::normal_distribution<float> noise(0.0f, static_cast<float>(hooks->pilot_noise));
+      for (float& a : b.action.continuous) a = std::clamp(a + noise(*hooks->pilot_rng), -1.0f, 1.0f);
+    }
+    for (float a : b.action.continuous) saturated += std::abs(a) >= 0.99f;
     r = &env.step(b.action.continuous.data(), mode_of(scene.current()));
     if (observe) (*observe)(env);
     segment.add_step(r->reward, r->stairs_climbed_now);
     log.return_R1 += r->reward;
-    fill_motion(env, image, b.next);
+    fill_motion(env, t, b.next);
     const bool done = r->terminated || r->truncated;
     if (hooks) hooks->motion(b.obs, b.action, static_cast<float>(r->reward), b.next, r->terminated, r->truncated);
     std::swap(b.obs, b.next);
@@ -225,14 +271,14 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
     //    new decision among [2, C_n].
     const double r2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
     return_r2 += r2;
-    fill_config(env, modules, scene.current(), c.trainer.config_vector, b, b.cnext);
+    fill_config(env, t, modules, scene.current(), b, b.cnext);
     if (hooks) hooks->config(b.cobs, b.caction, static_cast<float>(r2), b.cnext, false, false, segment.steps());
     std::swap(b.cobs, b.cnext);
     const int next_modules = choose(b.cobs);
     if (next_modules < modules) {
       env.reconfigure(next_modules);
       modules = next_modules;
-      fill_motion(env, image, b.obs);
+      fill_motion(env, t, b.obs);
     }
     if (log.configurations.back() != modules) log.configurations.push_back(modules);
     segment.begin(env.stairs_climbed(), env.stairs_energy());
@@ -241,7 +287,7 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
   if (hierarchical) {
     const double r2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
     return_r2 += r2;
-    fill_config(env, modules, scene.current(), c.trainer.config_vector, b, b.cnext);
+    fill_config(env, t, modules, scene.current(), b, b.cnext);
     if (hooks)
       hooks->config(b.cobs, b.caction, static_cast<float>(r2), b.cnext, r->terminated, r->truncated, segment.steps());
   }
@@ -260,6 +306,8 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
   log.return_R2 = return_r2;
   log.steps = m.steps;
   log.stairs_energy_J = env.stairs_energy();
+  log.action_saturation =
+      m.steps > 0 ? static_cast<double>(saturated) / (static_cast<double>(m.steps) * control::kActionSize) : 0.0;
   return log;
 }
 
@@ -439,7 +487,8 @@ struct Trainer::Impl {
   task::MultiTaskEnv env;
   SceneSource scene;
   Buffers buffers;
-  std::mt19937_64 rng;                   // warm-up configuration choices
+  std::mt19937_64 rng;                   // warm-up configuration choices, noise on the pilot's actions
+  task::ScriptedPilot pilot;             // demonstrations (trainer.warmup_policy: scripted)
 
   // Hand-over buffers: `filling` is written by the acting thread while the
   // learner consumes the other one.
@@ -472,6 +521,7 @@ struct Trainer::Impl {
     }
     worker = std::make_unique<LearnerWorker>(c.trainer.learner_thread);
     scene.label_source = callbacks.label_source;
+    pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};  // the gait the physics-table search picks
   }
 
   double wall() const { return wall_before + std::chrono::duration<double>(Clock::now() - started).count(); }
@@ -516,6 +566,7 @@ struct Trainer::Impl {
       tr.next.image = n.image;
       tr.next.vector = n.vector;
       tr.action.continuous = a.continuous;
+      tr.action.demonstration = a.demonstration;
       tr.reward = r;
       tr.terminated = term;
       tr.truncated = trunc;
@@ -549,6 +600,13 @@ struct Trainer::Impl {
           if (mask[a] && k-- == 0) return a;
         return -1;
       };
+    const bool scripted = t.warmup_policy == "scripted" &&
+                          (warmup || (t.scripted_interval > 0 && episode % t.scripted_interval == 0));
+    if (scripted) {
+      hooks.pilot = &pilot;
+      hooks.pilot_noise = t.warmup_noise;
+      hooks.pilot_rng = &rng;
+    }
     task::EpisodeSpec spec;
     spec.seed = static_cast<std::uint64_t>(t.seed) * 1000003ULL + static_cast<std::uint64_t>(episode);
     spec.stair_height = t.stair_height;

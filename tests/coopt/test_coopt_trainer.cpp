@@ -112,6 +112,43 @@ TEST(Trainer, ResultsDoNotDependOnTheLearnerThread) {
   fs::remove_all(b);
 }
 
+// The quick preset's additions (demonstrations, clearance row, scaled state,
+// decision camera) keep the schedule a function of the step count.
+const std::vector<std::string> kWithDemonstrations{
+    "trainer.warmup_policy=scripted", "trainer.scripted_interval=2", "trainer.motion_clearance=true",
+    "trainer.normalize_state=true",   "trainer.decision_camera=true",  "td3.bc_weight=1.0"};
+
+TEST(Trainer, ResultsWithDemonstrationsDoNotDependOnTheLearnerThread) {
+  const std::string a = temp_dir("demo_thr_a"), b = temp_dir("demo_thr_b");
+  std::vector<std::string> threaded = kWithDemonstrations, inline_ = kWithDemonstrations;
+  threaded.push_back("trainer.learner_thread=true");
+  inline_.push_back("trainer.learner_thread=false");
+  EXPECT_EQ(run_ci(threaded, a).episodes, run_ci(inline_, b).episodes);
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
+// The scripted pilot drives the warm-up: it climbs straight at the stairs (in
+// ci's 120 steps it gets most of the way to the first riser and beyond), where
+// uniform random actions go nowhere in particular.
+TEST(Trainer, ScriptedWarmupDrivesTowardsTheGoal) {
+  const std::string a = temp_dir("warm_scripted"), b = temp_dir("warm_random");
+  std::vector<std::string> scripted = kWithDemonstrations;
+  scripted.push_back("trainer.warmup_episodes=4");
+  const RunResult pilot = run_ci(scripted, a);
+  const RunResult random = run_ci({"trainer.warmup_episodes=4"}, b);
+  double pilot_d = 0, random_d = 0;
+  for (int e = 0; e < 4; ++e) {
+    EXPECT_TRUE(pilot.logs[e].warmup);
+    pilot_d += pilot.logs[e].distance_fraction / 4;
+    random_d += random.logs[e].distance_fraction / 4;
+  }
+  std::printf("warm-up distance fraction: scripted %.3f, random %.3f\n", pilot_d, random_d);
+  EXPECT_GT(pilot_d, random_d + 0.03);
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
 TEST(Trainer, ResumeAfterInterruptionContinuesTheSameEpisodesWithIdenticalResults) {
   const std::vector<std::string> sets{"trainer.episodes=6", "trainer.checkpoint_interval=3"};
   const std::string full_dir = temp_dir("full");
