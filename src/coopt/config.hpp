@@ -55,6 +55,10 @@ struct TrainerParams {
   std::string warmup_policy = "random";
   double warmup_noise = 0.2;          // std of the noise on the pilot's actions (action units)
   int scripted_interval = 0;          // after the warm-up, every this-many-th episode is the pilot's too (0 = none)
+  // Every training transition carries the pilot's action for its state as a
+  // behaviour-cloning target (td3.bc_weight), also where the motion model drove:
+  // the pilot labels the states the learner visits (DAgger, Ross et al. 2011).
+  bool pilot_labels = false;
   std::string scene_source = "ground_truth";  // ground_truth (simulator labels) | classifier (ResNet-18 on depth)
   std::string classifier_dir;         // trained classifier directory (scene_source: classifier)
   std::string scenario = "default";   // training scene: default | obstacles7 | obstacles8 | mixed

@@ -137,9 +137,12 @@ struct LearnHooks {
   std::function<void(const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool, int)>
       config;
   std::function<int(const std::vector<std::uint8_t>&)> random_config;  // warm-up choice, -1 = ask the DQN
-  // Demonstrations: when set, the pilot drives (its action + Gaussian noise of
-  // std pilot_noise from pilot_rng) instead of the motion model's action.
+  // The scripted pilot, when set, plans every episode and gives each step's
+  // action as the transition's behaviour-cloning target (Action::target); with
+  // pilot_drives it also drives (its action + Gaussian noise of std pilot_noise
+  // from pilot_rng) instead of the motion model.
   task::ScriptedPilot* pilot = nullptr;
+  bool pilot_drives = false;
   double pilot_noise = 0;
   std::mt19937_64* pilot_rng = nullptr;
 };
@@ -246,12 +249,17 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
   std::int64_t saturated = 0;
   while (true) {
     agent.motion->act(b.obs, explore, b.action);  // also when the pilot drives: the same RNG stream
-    b.action.demonstration = pilot != nullptr;
     if (pilot) {
       control::MotionMode pilot_mode;
-      pilot->act(env, b.action.continuous.data(), pilot_mode);
-      std::normal_distribution<float> noise(0.0f, static_cast<float>(hooks->pilot_noise));
-      for (float& a : b.action.continuous) a = std::clamp(a + noise(*hooks->pilot_rng), -1.0f, 1.0f);
+      b.action.target.resize(control::kActionSize);  // sized once: no allocation after the first step
+      pilot->act(env, b.action.target.data(), pilot_mode);
+      if (hooks->pilot_drives) {
+        std::normal_distribution<float> noise(0.0f, static_cast<float>(hooks->pilot_noise));
+        for (int i = 0; i < control::kActionSize; ++i)
+          b.action.continuous[i] = std::clamp(b.action.target[i] + noise(*hooks->pilot_rng), -1.0f, 1.0f);
+      }
+    } else {
+      b.action.target.clear();
     }
     for (float a : b.action.continuous) saturated += std::abs(a) >= 0.99f;
     r = &env.step(b.action.continuous.data(), mode_of(scene.current()));
@@ -488,7 +496,7 @@ struct Trainer::Impl {
   SceneSource scene;
   Buffers buffers;
   std::mt19937_64 rng;                   // warm-up configuration choices, noise on the pilot's actions
-  task::ScriptedPilot pilot;             // demonstrations (trainer.warmup_policy: scripted)
+  task::ScriptedPilot pilot;             // demonstrations and targets (warmup_policy: scripted, pilot_labels)
 
   // Hand-over buffers: `filling` is written by the acting thread while the
   // learner consumes the other one.
@@ -566,7 +574,7 @@ struct Trainer::Impl {
       tr.next.image = n.image;
       tr.next.vector = n.vector;
       tr.action.continuous = a.continuous;
-      tr.action.demonstration = a.demonstration;
+      tr.action.target = a.target;
       tr.reward = r;
       tr.terminated = term;
       tr.truncated = trunc;
@@ -602,8 +610,9 @@ struct Trainer::Impl {
       };
     const bool scripted = t.warmup_policy == "scripted" &&
                           (warmup || (t.scripted_interval > 0 && episode % t.scripted_interval == 0));
-    if (scripted) {
+    if (scripted || t.pilot_labels) {
       hooks.pilot = &pilot;
+      hooks.pilot_drives = scripted;
       hooks.pilot_noise = t.warmup_noise;
       hooks.pilot_rng = &rng;
     }

@@ -45,7 +45,9 @@ struct Observation {
 struct Action {
   int discrete = -1;              // index in [0, size) for discrete actions
   std::vector<float> continuous;  // size values in [-1, 1] for continuous actions
-  bool demonstration = false;     // chosen by a demonstrator (scripted pilot), not by the learner
+  // A demonstrator's action for the same state (a behaviour-cloning target,
+  // continuous only), or empty when there is none.
+  std::vector<float> target;
 };
 
 struct StepResult {

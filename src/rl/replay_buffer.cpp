@@ -39,7 +39,8 @@ ReplayBuffer::ReplayBuffer(ObservationSpec observation, ActionSpec action, std::
   reward_ = torch::zeros({capacity}, f32);
   discount_ = torch::zeros({capacity}, f32);
   terminated_ = torch::zeros({capacity}, f32);
-  demonstration_ = torch::zeros({capacity}, f32);
+  if (action.kind == ActionKind::kContinuous) target_ = torch::zeros({capacity, action.size}, f32);
+  has_target_ = torch::zeros({capacity}, f32);
 }
 
 void ReplayBuffer::store_image(const std::vector<float>& image, torch::Tensor& storage,
@@ -98,7 +99,14 @@ void ReplayBuffer::add(const Observation& obs, const Action& action, float rewar
   reward_.data_ptr<float>()[slot] = reward;
   discount_.data_ptr<float>()[slot] = discount;
   terminated_.data_ptr<float>()[slot] = terminated ? 1.0f : 0.0f;
-  demonstration_.data_ptr<float>()[slot] = action.demonstration ? 1.0f : 0.0f;
+  if (!action.target.empty()) {
+    if (!target_.defined() || static_cast<int>(action.target.size()) != action_spec_.size)
+      throw std::invalid_argument("ReplayBuffer::add: a target needs a continuous action of the same size");
+    std::copy(action.target.begin(), action.target.end(), target_.data_ptr<float>() + slot * action_spec_.size);
+  } else if (target_.defined()) {
+    std::fill_n(target_.data_ptr<float>() + slot * action_spec_.size, action_spec_.size, 0.0f);
+  }
+  has_target_.data_ptr<float>()[slot] = action.target.empty() ? 0.0f : 1.0f;
   position_ = (position_ + 1) % capacity_;
   size_ = std::min(size_ + 1, capacity_);
 }
@@ -125,7 +133,8 @@ ReplayBatch ReplayBuffer::gather(const torch::Tensor& slots, const torch::Device
   b.bootstrap = (discount_.index_select(0, slots) * (1.0f - terminated_.index_select(0, slots)))
                     .to(device);
   if (next_valid_.defined()) b.next_valid_actions = next_valid_.index_select(0, slots).to(device);
-  b.demonstration = demonstration_.index_select(0, slots).to(device);
+  if (target_.defined()) b.target = target_.index_select(0, slots).to(device);
+  b.has_target = has_target_.index_select(0, slots).to(device);
   return b;
 }
 
@@ -160,7 +169,8 @@ void ReplayBuffer::save(torch::serialize::OutputArchive& a) const {
   a.write("reward", filled(reward_));
   a.write("discount", filled(discount_));
   a.write("terminated", filled(terminated_));
-  a.write("demonstration", filled(demonstration_));
+  if (target_.defined()) a.write("target", filled(target_));
+  a.write("has_target", filled(has_target_));
   if (next_valid_.defined()) a.write("next_valid", filled(next_valid_));
 }
 
@@ -199,13 +209,12 @@ void ReplayBuffer::load(torch::serialize::InputArchive& a) {
   restore("reward", reward_);
   restore("discount", discount_);
   restore("terminated", terminated_);
-  demonstration_.zero_();
-  {  // absent in buffers saved before demonstrations existed: none were
-    torch::Tensor src;
-    if (a.try_read("demonstration", src)) {
-      if (src.size(0) != size_) throw std::runtime_error("ReplayBuffer::load: field \"demonstration\" has the wrong shape");
-      demonstration_.slice(0, 0, size_).copy_(src);
-    }
+  // Buffers saved before behaviour-cloning targets existed have none.
+  has_target_.zero_();
+  torch::Tensor saved;
+  if (a.try_read("has_target", saved)) {
+    restore("has_target", has_target_);
+    if (target_.defined()) restore("target", target_);
   }
   if (next_valid_.defined()) restore("next_valid", next_valid_);
 }

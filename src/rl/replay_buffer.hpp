@@ -33,7 +33,8 @@ struct ReplayBatch {
   torch::Tensor reward;                      // [B] float32
   torch::Tensor bootstrap;                   // [B] float32: discount, 0 when terminated
   torch::Tensor next_valid_actions;          // [B, n] bool (discrete), or undefined
-  torch::Tensor demonstration;               // [B] float32: 1 where a demonstrator chose the action
+  torch::Tensor target;                      // [B, A] float32: the demonstrator's action (continuous), 0 where none
+  torch::Tensor has_target;                  // [B] float32: 1 where the transition has a target
 };
 
 class ReplayBuffer {
@@ -74,7 +75,7 @@ class ReplayBuffer {
   std::int64_t position_ = 0;
 
   torch::Tensor image_, next_image_, vector_, next_vector_;
-  torch::Tensor action_, reward_, discount_, terminated_, next_valid_, demonstration_;
+  torch::Tensor action_, reward_, discount_, terminated_, next_valid_, target_, has_target_;
 };
 
 }  // namespace comorph::rl

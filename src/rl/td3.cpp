@@ -162,7 +162,7 @@ void Td3::update() {
       const double w = bc_weight_now();
       actor_loss = -q.mean() / q.abs().mean().detach().clamp_min(1e-6);
       if (w > 0)
-        actor_loss = actor_loss + w * ((pi - b.action).pow(2).sum(1) * b.demonstration).mean();
+        actor_loss = actor_loss + w * ((pi - b.target).pow(2).sum(1) * b.has_target).mean();
     } else {
       actor_loss = -q.mean();
     }

@@ -40,9 +40,9 @@ struct Td3Config {
   double exploration_noise_decay = 0;    // decay length; 0 = constant `end`
   std::string exploration_noise_unit = "transitions";  // decay counted in "transitions" or "episodes"
   double max_grad_norm = 0;              // clip gradient L2 norms; 0 = off
-  // Behaviour cloning on demonstrated transitions (TD3+BC, Fujimoto & Gu 2021):
-  // actor loss = -Q / mean|Q| + w * (squared error to the demonstrated action on
-  // demonstration samples). w falls linearly from bc_weight to 0 over
+  // Behaviour cloning towards the demonstrator's action of the transitions that
+  // carry one (Action::target; TD3+BC, Fujimoto & Gu 2021):
+  // actor loss = -Q / mean|Q| + w * (squared error to the target, where there is one). w falls linearly from bc_weight to 0 over
   // bc_decay_updates actor updates (0 = constant). bc_weight 0 = plain TD3.
   double bc_weight = 0;
   std::int64_t bc_decay_updates = 0;

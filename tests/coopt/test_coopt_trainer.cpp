@@ -116,7 +116,8 @@ TEST(Trainer, ResultsDoNotDependOnTheLearnerThread) {
 // decision camera) keep the schedule a function of the step count.
 const std::vector<std::string> kWithDemonstrations{
     "trainer.warmup_policy=scripted", "trainer.scripted_interval=2", "trainer.motion_clearance=true",
-    "trainer.normalize_state=true",   "trainer.decision_camera=true",  "td3.bc_weight=1.0"};
+    "trainer.normalize_state=true",   "trainer.decision_camera=true",  "trainer.pilot_labels=true",
+    "td3.bc_weight=1.0"};
 
 TEST(Trainer, ResultsWithDemonstrationsDoNotDependOnTheLearnerThread) {
   const std::string a = temp_dir("demo_thr_a"), b = temp_dir("demo_thr_b");

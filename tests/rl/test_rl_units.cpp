@@ -400,8 +400,10 @@ double bc_error_after_training(double bc_weight) {
   rl::Action a;
   for (int i = 0; i < 400; ++i) {
     const float x = static_cast<float>(i % 20) / 10.0f - 0.95f;
-    a.demonstration = i % 2 == 0;
-    a.continuous = {a.demonstration ? (x > 0 ? 0.7f : -0.4f) : 0.9f * (i % 3 == 0 ? 1.0f : -1.0f)};
+    const bool demonstrated = i % 2 == 0;
+    a.continuous = {demonstrated ? (x > 0 ? 0.7f : -0.4f) : 0.9f * (i % 3 == 0 ? 1.0f : -1.0f)};
+    a.target.clear();
+    if (demonstrated) a.target = a.continuous;
     td3.store(vector_obs({x}), a, 1.0f, vector_obs({x}), true, false);
   }
   for (int u = 0; u < 800; ++u) td3.update();
@@ -421,12 +423,13 @@ TEST(Td3, BehaviourCloningPullsTheActorToTheDemonstratedActions) {
   EXPECT_GT(without, 0.2);
 }
 
-TEST(ReplayBuffer, KeepsTheDemonstrationFlagThroughSaveAndLoad) {
+TEST(ReplayBuffer, KeepsBehaviourCloningTargetsThroughSaveAndLoad) {
   rl::ReplayBuffer buffer({0, 0, 0, 1}, {rl::ActionKind::kContinuous, 1}, 4);
   rl::Action a;
   a.continuous = {0.1f};
   for (int i = 0; i < 3; ++i) {
-    a.demonstration = i == 1;
+    a.target.clear();
+    if (i == 1) a.target = {-0.3f};
     buffer.add(vector_obs({float(i)}), a, 0.0f, vector_obs({0}), false, 0.99f);
   }
   const std::string path = temp_path("replay_demo.pt");
@@ -434,9 +437,11 @@ TEST(ReplayBuffer, KeepsTheDemonstrationFlagThroughSaveAndLoad) {
   rl::ReplayBuffer restored({0, 0, 0, 1}, {rl::ActionKind::kContinuous, 1}, 4);
   restored.load(path);
   const rl::ReplayBatch b = restored.gather(torch::arange(3), torch::kCPU);
-  EXPECT_EQ(b.demonstration[0].item<float>(), 0.0f);
-  EXPECT_EQ(b.demonstration[1].item<float>(), 1.0f);
-  EXPECT_EQ(b.demonstration[2].item<float>(), 0.0f);
+  EXPECT_EQ(b.has_target[0].item<float>(), 0.0f);
+  EXPECT_EQ(b.has_target[1].item<float>(), 1.0f);
+  EXPECT_EQ(b.has_target[2].item<float>(), 0.0f);
+  EXPECT_FLOAT_EQ(b.target[1][0].item<float>(), -0.3f);
+  EXPECT_FLOAT_EQ(b.action[1][0].item<float>(), 0.1f);  // the executed action stays apart
   std::filesystem::remove(path);
 }
 
