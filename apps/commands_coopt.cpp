@@ -35,6 +35,12 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   ev->add_option("--seed", seed, "seed of episode 0 (episode i: seed + i; default: eval.seed)");
   ev->add_option("--workers", workers, "threads (default: eval.workers; 0 there = one per core); results do not depend on it");
   ev->callback([] { comorph::cli::eval_run(run, scenario, episodes, seed, workers); });
+
+  auto* ex = app.add_subcommand("export", "copy a trained run's policies (no replay buffers) and logs, e.g. into results/");
+  static std::string export_run, export_out;
+  ex->add_option("--run", export_run, "trained run directory")->required();
+  ex->add_option("--out", export_out, "destination directory, e.g. results/standard-hier-td3")->required();
+  ex->callback([] { comorph::cli::export_run(export_run, export_out); });
 }};
 
 }  // namespace

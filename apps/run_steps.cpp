@@ -197,4 +197,26 @@ report::Metrics eval_run(const std::string& run_dir, const std::string& scenario
   return m;
 }
 
+std::uintmax_t export_run(const std::string& run_dir, const std::string& out) {
+  const std::string path = (fs::path(run_dir) / "config.yaml").string();
+  if (!fs::exists(path)) throw std::runtime_error(run_dir + ": not a training run (no config.yaml)");
+  if (fs::exists(out) && fs::equivalent(out, run_dir)) throw std::runtime_error("export: --out is the run itself");
+  const CooptConfig config = comorph::coopt::load_coopt_config(path);
+  fs::remove_all(fs::path(out) / "checkpoint");
+  fs::create_directories(out);
+  std::uintmax_t bytes = comorph::coopt::export_policy(config, run_dir, (fs::path(out) / "checkpoint").string());
+  for (const auto& e : fs::directory_iterator(run_dir)) {
+    const std::string name = e.path().filename().string();
+    const bool eval_file = name.rfind("eval-", 0) == 0 && (e.path().extension() == ".json" || e.path().extension() == ".csv");
+    if (!e.is_regular_file()) continue;
+    if (name != "config.yaml" && name != "run.yaml" && name != "episodes.csv" && name != "evaluations.csv" && !eval_file)
+      continue;
+    fs::copy_file(e.path(), fs::path(out) / name, fs::copy_options::overwrite_existing);
+    bytes += fs::file_size(e.path());
+  }
+  std::printf("exported %s to %s: %.2f MB (networks without replay buffers or optimizers)\n", run_dir.c_str(),
+              out.c_str(), static_cast<double>(bytes) / 1e6);
+  return bytes;
+}
+
 }  // namespace comorph::cli

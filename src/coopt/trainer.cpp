@@ -819,6 +819,20 @@ std::vector<EpisodeLog> evaluate(const CooptConfig& config, const std::string& r
   return logs;
 }
 
+std::uintmax_t export_policy(const CooptConfig& config, const std::string& run_dir,
+                             const std::string& out_checkpoint_dir) {
+  const CheckpointInfo info = open_checkpoint_for_evaluation(config, run_dir);
+  GreedyPlayer player(config, info);
+  fs::create_directories(out_checkpoint_dir);
+  const fs::path out(out_checkpoint_dir);
+  player.agent.motion->save_policy((out / "motion_actor.pt").string());
+  if (player.agent.config) player.agent.config->save_policy((out / "config_model.pt").string());
+  fs::copy_file(fs::path(info.directory) / "trainer.yaml", out / "trainer.yaml", fs::copy_options::overwrite_existing);
+  std::uintmax_t bytes = 0;
+  for (const auto& e : fs::directory_iterator(out)) bytes += fs::file_size(e.path());
+  return bytes;
+}
+
 EpisodeLog play_evaluation_episode(const CooptConfig& config, const std::string& run_dir,
                                    const EvalEpisodeRequest& request, const StepObserver& observer) {
   if (request.index < 0)

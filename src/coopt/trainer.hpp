@@ -139,6 +139,14 @@ std::vector<EpisodeLog> evaluate(const CooptConfig& config, const std::string& r
 // it cannot change the episode.
 using StepObserver = std::function<void(const task::MultiTaskEnv&)>;
 
+// Writes the acting networks of run_dir's checkpoint, without target networks,
+// optimizers or replay buffers, to out_checkpoint_dir (motion_actor.pt,
+// config_model.pt in hierarchical mode, and trainer.yaml): a checkpoint that
+// evaluate(), play_evaluation_episode() and `comorph render` read like the full
+// one, but that cannot resume training. Returns the bytes written.
+std::uintmax_t export_policy(const CooptConfig& config, const std::string& run_dir,
+                             const std::string& out_checkpoint_dir);
+
 // One episode of an evaluation, replayed alone.
 struct EvalEpisodeRequest {
   std::string scenario = "default";  // default | obstacles7 | obstacles8 | mixed

@@ -148,10 +148,25 @@ void Dqn::save(const std::string& path) const {
   a.save_to(path);
 }
 
+void Dqn::save_policy(const std::string& path) const {
+  torch::serialize::OutputArchive a, nets;
+  write_common(a, counters_, rng_, "dqn");
+  mark_policy_only(a);
+  q_->save(nets);
+  a.write("q", nets);
+  a.save_to(path);
+}
+
 void Dqn::load(const std::string& path) {
   torch::serialize::InputArchive a, nets, target, opt, replay;
   a.load_from(path, device_);
   read_common(a, counters_, rng_, "dqn");
+  if (is_policy_only(a)) {
+    torch::serialize::InputArchive policy;
+    a.read("q", policy);
+    q_->load(policy);
+    return;
+  }
   a.read("q", nets);
   a.read("q_target", target);
   a.read("optimizer", opt);

@@ -60,6 +60,13 @@ void write_common(torch::serialize::OutputArchive& a, const LearnerCounters& c,
   a.write("rng", c10::IValue(rng_state(rng)));
 }
 
+void mark_policy_only(torch::serialize::OutputArchive& a) { a.write("policy_only", c10::IValue(true)); }
+
+bool is_policy_only(torch::serialize::InputArchive& a) {
+  c10::IValue flag;
+  return a.try_read("policy_only", flag) && flag.toBool();
+}
+
 void read_common(torch::serialize::InputArchive& a, LearnerCounters& c, std::mt19937_64& rng,
                  const std::string& algorithm) {
   c10::IValue name;

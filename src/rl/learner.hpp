@@ -55,6 +55,11 @@ class Learner {
   // replay buffer, counters, RNG state.
   virtual void save(const std::string& path) const = 0;
   virtual void load(const std::string& path) = 0;
+  // The networks alone (no target networks, optimizers or replay): what a
+  // trained policy ships as. load() reads either kind; after a policy-only
+  // file the learner acts as the saved one did (greedy), and everything else
+  // stays as constructed, so it cannot continue training exactly.
+  virtual void save_policy(const std::string& path) const = 0;
   virtual const LearnerCounters& counters() const = 0;
   // Loss of the latest update() (critic / Q loss), for logs.
   virtual double last_loss() const = 0;
@@ -110,5 +115,8 @@ void write_common(torch::serialize::OutputArchive& archive, const LearnerCounter
                   const std::mt19937_64& rng, const std::string& algorithm);
 void read_common(torch::serialize::InputArchive& archive, LearnerCounters& counters,
                  std::mt19937_64& rng, const std::string& algorithm);
+// Marks an archive as policy-only (save_policy) / tells whether it is one.
+void mark_policy_only(torch::serialize::OutputArchive& archive);
+bool is_policy_only(torch::serialize::InputArchive& archive);
 
 }  // namespace comorph::rl

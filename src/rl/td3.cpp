@@ -191,10 +191,25 @@ void Td3::save(const std::string& path) const {
   a.save_to(path);
 }
 
+void Td3::save_policy(const std::string& path) const {
+  torch::serialize::OutputArchive a, nets;
+  write_common(a, counters_, rng_, "td3");
+  mark_policy_only(a);
+  nets_->save(nets);
+  a.write("networks", nets);
+  a.save_to(path);
+}
+
 void Td3::load(const std::string& path) {
   torch::serialize::InputArchive a, nets, target, actor_opt, critic_opt, replay;
   a.load_from(path, device_);
   read_common(a, counters_, rng_, "td3");
+  if (is_policy_only(a)) {
+    torch::serialize::InputArchive policy;
+    a.read("networks", policy);
+    nets_->load(policy);
+    return;
+  }
   a.read("networks", nets);
   a.read("target_networks", target);
   a.read("actor_optimizer", actor_opt);

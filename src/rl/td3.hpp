@@ -69,6 +69,7 @@ class Td3 final : public Learner {
   void update() override;
   void save(const std::string& path) const override;
   void load(const std::string& path) override;
+  void save_policy(const std::string& path) const override;
   const LearnerCounters& counters() const override { return counters_; }
   double last_loss() const override { return last_loss_; }
 
