@@ -8,6 +8,8 @@
 
 #include <fmt/format.h>
 
+#include "common/file_io.hpp"
+
 namespace fs = std::filesystem;
 
 namespace comorph::report {
@@ -67,9 +69,7 @@ void write_run_info(const std::string& path, const RunInfo& info) {
   if (!info.preset.empty()) out << YAML::Key << "preset" << YAML::Value << info.preset;
   if (!info.notes.empty()) out << YAML::Key << "notes" << YAML::Value << info.notes;
   out << YAML::EndMap;
-  std::ofstream file(path);
-  if (!file) throw std::runtime_error(fmt::format("cannot write {}", path));
-  file << out.c_str() << "\n";
+  write_file_atomic(path, std::string(out.c_str()) + "\n");
 }
 
 RunDir load_run_dir(const std::string& path) {
