@@ -3,7 +3,12 @@
 #include <torch/torch.h>
 
 #include <dlfcn.h>
+#include <fcntl.h>
+#include <unistd.h>
 
+#include <cerrno>
+
+#include <optional>
 #include <sstream>
 
 namespace comorph::rl {
@@ -11,11 +16,22 @@ namespace comorph::rl {
 std::string rl_config_dir() { return std::string(COMORPH_SOURCE_DIR) + "/configs/rl"; }
 
 void check_device_name(const std::string& name) {
+  std::optional<torch::Device> device;
   try {
-    torch::Device device(name);
-    (void)device;
+    device.emplace(name);
   } catch (const std::exception&) {
-    throw std::invalid_argument("unknown torch device \"" + name + "\" (use cpu, cuda, cuda:N)");
+    throw std::invalid_argument("unknown torch device \"" + quote_value(name) + "\" (use cpu, cuda, cuda:N)");
+  }
+  if (device->is_cuda()) {
+    if (!torch::cuda::is_available())
+      throw std::invalid_argument("torch device \"" + name + "\" is not available: this LibTorch or machine has "
+                                  "no CUDA device (use cpu)");
+    const auto count = static_cast<int>(torch::cuda::device_count());
+    if (device->has_index() && device->index() >= count)
+      throw std::invalid_argument("torch device \"" + name + "\" is not available: " + std::to_string(count) +
+                                  " CUDA device(s) here");
+  } else if (!device->is_cpu()) {
+    throw std::invalid_argument("torch device \"" + name + "\" is not supported (use cpu, cuda, cuda:N)");
   }
 }
 
@@ -39,6 +55,30 @@ void set_torch_threads(int intra_op_threads, int inter_op_threads) {
     }
     inter_op_set = true;
   }
+}
+
+void save_archive(torch::serialize::OutputArchive& archive, const std::string& path) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error(system_error_message("cannot write", path, errno));
+  int error = 0;  // errno of the first failed write; later bytes are dropped
+  archive.save_to([&](const void* data, std::size_t size) -> std::size_t {
+    const char* p = static_cast<const char*>(data);
+    std::size_t left = error ? 0 : size;
+    while (left > 0) {
+      const ssize_t n = ::write(fd, p, left);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) {
+        error = errno;
+        break;
+      }
+      p += n;
+      left -= static_cast<std::size_t>(n);
+    }
+    return size;  // always "written": see the header
+  });
+  if (!error && ::fsync(fd) != 0) error = errno;
+  if (::close(fd) != 0 && !error) error = errno;
+  if (error) throw std::runtime_error(system_error_message("cannot write", path, error));
 }
 
 std::string rng_state(const std::mt19937_64& rng) {
