@@ -28,6 +28,7 @@
 #include <stdexcept>
 
 #include "cli_numbers.hpp"
+#include "common/file_io.hpp"
 #include "command_registry.hpp"
 #include "coopt/scene_dataset.hpp"
 #include "perception/dataset.hpp"
@@ -195,15 +196,6 @@ std::string json_delays(const perception::SwitchDelayReport& d, double max) {
       json_number(d.mean_delay()), json_number(max), d.detected, d.missed, d.false_switches);
 }
 
-void write_text_atomically(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream f(tmp);
-    f << text;
-    if (!f) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  fs::rename(tmp, path);
-}
 
 void run_prepare(const PrepareOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
@@ -310,7 +302,7 @@ void run_prepare(const PrepareOptions& o) {
     const double total_seconds = seconds_since(t_start);
     say(fmt::format("wall time: data {:.1f} s, training {:.1f} s, switch episodes {:.1f} s, total {:.1f} s\n",
                     train.stats.seconds + eval.stats.seconds, train_seconds, sw.seconds, total_seconds));
-    write_text_atomically(stage / "classifier-eval.txt", report.str());
+    comorph::write_file_atomic((stage / "classifier-eval.txt").string(), report.str());
     std::string confusion = "[";
     for (std::size_t t = 0; t < r.eval.confusion.size(); ++t) {
       confusion += t ? ", [" : "[";
@@ -319,8 +311,8 @@ void run_prepare(const PrepareOptions& o) {
       confusion += "]";
     }
     confusion += "]";
-    write_text_atomically(
-        stage / "classifier-eval.json",
+    comorph::write_file_atomic(
+        (stage / "classifier-eval.json").string(),
         fmt::format("{{\n  \"train_seeds\": [{}, {}],\n  \"eval_seeds\": [{}, {}],\n  \"train_images\": {},\n"
                     "  \"eval_images\": {},\n  \"width\": {},\n  \"epochs\": {},\n  \"eval_accuracy\": {},\n"
                     "  \"eval_accuracy_run_frames\": {},\n  \"eval_accuracy_view_frames\": {},\n"

@@ -8,21 +8,14 @@
 
 #include <fmt/format.h>
 
-#include "common/file_io.hpp"
+#include "common/yaml_fields.hpp"  // load_yaml_file, write_file_atomic
 
 namespace fs = std::filesystem;
 
 namespace comorph::report {
 
 RunInfo read_run_info(const std::string& path, const std::string& default_name) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw std::runtime_error(fmt::format("cannot open {}", path));
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(fmt::format("{}: invalid YAML: {}", path, e.what()));
-  }
+  const YAML::Node root = load_yaml_file(path);  // size cap, duplicate keys
   if (!root.IsMap()) throw std::runtime_error(fmt::format("{}: expected a map of fields", path));
   auto text = [&](const char* key, bool required, const std::string& fallback) {
     if (!root[key]) {

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "common/torch_archive.hpp"  // save_archive: every save()
 #include "common/yaml_fields.hpp"  // YamlFields, load_yaml_file: every from_yaml
 #include "rl/env.hpp"
 
@@ -119,12 +120,6 @@ void set_torch_threads(int intra_op_threads, int inter_op_threads);
 // RNG state as text (std::mt19937_64's stream format), for checkpoints.
 std::string rng_state(const std::mt19937_64& rng);
 void set_rng_state(std::mt19937_64& rng, const std::string& state);
-
-// Writes an archive to `path`, checked: a failed write (full disk) throws
-// "cannot write <path>: <reason>" once the archive is done. LibTorch 1.13
-// must never see the failure itself: its zip writer then throws again from a
-// destructor, and the process aborts (std::terminate, exit 134).
-void save_archive(torch::serialize::OutputArchive& archive, const std::string& path);
 
 // Shared checkpoint pieces.
 void write_common(torch::serialize::OutputArchive& archive, const LearnerCounters& counters,
