@@ -106,6 +106,15 @@ void add_shared_learner_fields(YamlFields& f, LearnerConfig& c) {
   f.add("device", &c.device);
 }
 
+// The fields TD3 and SAC (actor-critic learners) share, with their ranges.
+template <class ActorCriticConfig>
+void add_actor_critic_fields(YamlFields& f, ActorCriticConfig& c) {
+  f.add("actor_learning_rate", &c.actor_learning_rate, kMinPositive, 1.0);
+  f.add("critic_learning_rate", &c.critic_learning_rate, kMinPositive, 1.0);
+  f.add("random_action_steps", &c.random_action_steps, 0, kMaxSteps);
+  f.add("random_action_episodes", &c.random_action_episodes, 0, kMaxSteps);
+}
+
 // Layer widths must be positive (a list has no range of its own in YamlFields).
 template <class LearnerConfig>
 void check_hidden_sizes(const YamlFields& f, const LearnerConfig& c) {

@@ -10,11 +10,8 @@ SacConfig SacConfig::from_yaml(const YAML::Node& node, const std::string& source
   SacConfig c;
   YamlFields f(source);
   add_shared_learner_fields(f, c);
-  f.add("actor_learning_rate", &c.actor_learning_rate, kMinPositive, 1.0);
-  f.add("critic_learning_rate", &c.critic_learning_rate, kMinPositive, 1.0);
+  add_actor_critic_fields(f, c);
   f.add("alpha_learning_rate", &c.alpha_learning_rate, kMinPositive, 1.0);
-  f.add("random_action_steps", &c.random_action_steps, 0, kMaxSteps);
-  f.add("random_action_episodes", &c.random_action_episodes, 0, kMaxSteps);
   f.add("policy_frequency", &c.policy_frequency, 1, 1000000);
   f.add("target_network_frequency", &c.target_network_frequency, 1, 1000000);
   f.add("alpha", &c.alpha, kMinPositive, 1000.0);

@@ -10,10 +10,7 @@ Td3Config Td3Config::from_yaml(const YAML::Node& node, const std::string& source
   Td3Config c;
   YamlFields f(source);
   add_shared_learner_fields(f, c);
-  f.add("actor_learning_rate", &c.actor_learning_rate, kMinPositive, 1.0);
-  f.add("critic_learning_rate", &c.critic_learning_rate, kMinPositive, 1.0);
-  f.add("random_action_steps", &c.random_action_steps, 0, kMaxSteps);
-  f.add("random_action_episodes", &c.random_action_episodes, 0, kMaxSteps);
+  add_actor_critic_fields(f, c);
   f.add("policy_delay", &c.policy_delay, 1, 1000000);
   f.add("policy_noise", &c.policy_noise, 0.0, 10.0);
   f.add("noise_clip", &c.noise_clip, 0.0, 10.0);

@@ -18,14 +18,7 @@ namespace comorph {
 namespace {
 namespace fs = std::filesystem;
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
-}
+using test_support::error_of;
 
 TEST(FileIo, WriteToAFullDeviceNamesThePathAndTheReason) {
   const std::string e = error_of([] { write_file_atomic("/dev/full", std::string(100, 'x')); });

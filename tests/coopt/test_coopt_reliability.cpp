@@ -26,14 +26,7 @@ namespace fs = std::filesystem;
 const std::string kCi = std::string(COMORPH_SOURCE_DIR) + "/configs/ci.yaml";
 const std::string kSim = std::string(COMORPH_SOURCE_DIR) + "/configs/sim";
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
-}
+using test_support::error_of;
 
 // A finished ci run (warm-up 2 + 2 episodes, checkpoints after 2 and 4), so
 // that checkpoint/ counts 4 episodes and checkpoint.old/ 2.
