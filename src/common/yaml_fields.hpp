@@ -56,7 +56,7 @@ class YamlFields {
   void apply_text(const std::string& text) const;
 
   [[noreturn]] void fail(const std::string& field, const std::string& what) const {
-    throw std::runtime_error(source_ + ": field '" + field + "': " + what);
+    throw std::runtime_error(source_ + ": field '" + quote_value(field) + "': " + what);
   }
   const std::string& source() const { return source_; }
 

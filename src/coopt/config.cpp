@@ -13,7 +13,7 @@ namespace comorph::coopt {
 namespace {
 
 [[noreturn]] void fail(const std::string& source, const std::string& key, const std::string& what) {
-  throw std::runtime_error(source + ": field '" + key + "': " + what);
+  throw std::runtime_error(source + ": field '" + quote_value(key) + "': " + what);
 }
 
 // Sets root[a][b][c] = value for "a.b.c=value" (maps created as needed).
@@ -178,7 +178,7 @@ void scenario_settings(const std::string& scenario, int& obstacles, bool& mixed)
   if (scenario == "obstacles7") obstacles = 7;
   else if (scenario == "obstacles8") obstacles = 8;
   else if (scenario == "mixed") mixed = true;
-  else throw std::runtime_error("unknown scenario '" + scenario + "' (default | obstacles7 | obstacles8 | mixed)");
+  else throw std::runtime_error("unknown scenario '" + quote_value(scenario) + "' (default | obstacles7 | obstacles8 | mixed)");
 }
 
 CooptConfig coopt_config_from_text(const std::string& text, const std::string& source,

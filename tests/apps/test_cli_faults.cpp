@@ -107,6 +107,15 @@ TEST(RunLock, ASecondWriterIsRefusedWithTheHoldersPid) {
     EXPECT_EQ(exit_code(run_cli("train " + kTinyRun + " --out " + fresh, log)), 1);
     EXPECT_NE(log.find(fresh + " is in use by process " + pid), std::string::npos) << log;
   }
+  // An experiment column is locked for its training and evaluations too.
+  const std::string experiment = temp_dir("lock_experiment");
+  fs::create_directories(experiment + "/hier-td3");
+  {
+    comorph::RunLock held(experiment + "/hier-td3");
+    EXPECT_EQ(exit_code(run_cli("experiment --table 2 --only hier-td3 --config " + kCi + " --out " + experiment, log)),
+              1);
+    EXPECT_NE(log.find(experiment + "/hier-td3 is in use by process " + pid), std::string::npos) << log;
+  }
   // Released (as when the holder is killed): the resume runs (nothing left to train).
   EXPECT_EQ(exit_code(run_cli("train --resume " + run, log)), 0) << log;
 }

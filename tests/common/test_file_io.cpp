@@ -114,6 +114,9 @@ TEST(Yaml, ABadValueIsQuotedShort) {
   const std::string e = error_of([&] { f.apply_text("v: " + std::string(100000, 'q') + "\n"); });
   EXPECT_LT(e.size(), 200u) << e.substr(0, 300);
   EXPECT_NE(e.find("big.yaml: field 'v': bad value 'qqq"), std::string::npos);
+  const std::string key = error_of([&] { f.apply_text(std::string(1000, 'k') + ": 1\n"); });
+  EXPECT_LT(key.size(), 200u) << key.substr(0, 300);
+  EXPECT_NE(key.find("unknown field"), std::string::npos);
 }
 
 TEST(Checksum, FindsAFlippedByteATruncationAndAMissingFile) {
