@@ -672,7 +672,12 @@ struct Trainer::Impl {
       // A full disk: the last good checkpoint stays; free what the partial one took.
       std::error_code ignored;
       fs::remove_all(tmp, ignored);
-      throw;
+      try {
+        throw;
+      } catch (const c10::Error& e) {  // any other LibTorch failure: one line, no backtrace
+        const std::string what = e.what_without_backtrace();
+        throw std::runtime_error("cannot write the checkpoint " + tmp + ": " + what.substr(0, what.find('\n')));
+      }
     }
     // Swap directories: a crash at any point leaves either `checkpoint` or
     // `checkpoint.old` complete (read_checkpoint_info falls back to .old).
