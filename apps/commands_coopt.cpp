@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_numbers.hpp"
 #include "command_registry.hpp"
 #include "run_steps.hpp"
 
@@ -31,9 +32,13 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   static int episodes = 0, seed = -1, workers = 0;
   ev->add_option("--run", run, "run directory")->required();
   ev->add_option("--scenario", scenario, "default | obstacles7 | obstacles8 | mixed");
-  ev->add_option("--episodes", episodes, "episodes (default: eval.episodes of the run's config)");
-  ev->add_option("--seed", seed, "seed of episode 0 (episode i: seed + i; default: eval.seed)");
-  ev->add_option("--workers", workers, "threads (default: eval.workers; 0 there = one per core); results do not depend on it");
+  // The same ranges as the config's eval section (coopt/config.cpp).
+  ev->add_option("--episodes", episodes, "episodes (default: eval.episodes of the run's config)")
+      ->check(comorph::cli::whole_in(1, 1000000));
+  ev->add_option("--seed", seed, "seed of episode 0 (episode i: seed + i; default: eval.seed)")
+      ->check(comorph::cli::whole_in(0, 2000000000));
+  ev->add_option("--workers", workers, "threads (default: eval.workers; 0 there = one per core); results do not depend on it")
+      ->check(comorph::cli::whole_in(1, 256));
   ev->callback([] { comorph::cli::eval_run(run, scenario, episodes, seed, workers); });
 
   auto* ex = app.add_subcommand("export", "copy a trained run's policies (no replay buffers) and logs, e.g. into results/");

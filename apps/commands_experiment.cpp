@@ -22,6 +22,9 @@
 #include <fmt/format.h>
 
 #include "command_registry.hpp"
+#include "cli_numbers.hpp"
+#include "common/file_io.hpp"
+#include "common/run_lock.hpp"
 #include "coopt/config.hpp"
 #include "coopt/trainer.hpp"
 #include "report/paper_reference.hpp"
@@ -89,39 +92,33 @@ bool train_column(const ExperimentOptions& o, const Column& column, const comorp
                   const std::string& run_dir, ColumnTimes& times) {
   const int total = expected.trainer.warmup_episodes + expected.trainer.episodes;
 
-  if (fs::exists(run_dir) && !fs::is_empty(run_dir)) {
+  if (!comorph::cli::is_empty_run_dir(run_dir)) {
     const fs::path existing_config = fs::path(run_dir) / "config.yaml";
     if (!fs::exists(existing_config))
       throw std::runtime_error(run_dir + " exists and is not a training run (no config.yaml); move it away");
     if (comorph::coopt::load_coopt_config(existing_config.string()).text != expected.text)
       throw std::runtime_error(run_dir + " was trained with another configuration than --config/--set give now (" +
                                existing_config.string() + "); use another --out or remove it");
+    // Only a run without any checkpoint starts again: a damaged checkpoint is
+    // refused (read_checkpoint_info names the file), never thrown away.
     std::optional<comorph::coopt::CheckpointInfo> checkpoint;
-    try {
+    if (fs::exists(fs::path(run_dir) / "checkpoint") || fs::exists(fs::path(run_dir) / "checkpoint.old"))
       checkpoint = comorph::coopt::read_checkpoint_info(run_dir);
-    } catch (const std::exception&) {
-      // no complete checkpoint: handled below
-    }
     if (!checkpoint) {
       // Interrupted before its first checkpoint: nothing to resume.
       std::fprintf(stderr, "experiment: %s has no checkpoint yet; starting it again\n", run_dir.c_str());
-      fs::remove_all(run_dir);
+      comorph::cli::clear_run_dir(run_dir);  // keeps the lock file this call holds
     } else if (checkpoint->episodes >= total) {
+      comorph::coopt::check_checkpoint_counts(*checkpoint, expected);
       times.training = "done before";
       return true;
     } else {
       times.training = "resumed";
-      return comorph::cli::train_run("", {}, "", run_dir);
+      return comorph::cli::train_run("", {}, "", run_dir, true);
     }
   }
   times.training = "trained";
-  return comorph::cli::train_run(o.config, column_sets(o, column), run_dir, "");
-}
-
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path);
-  out << text;
-  if (!out) throw std::runtime_error("cannot write " + path.string());
+  return comorph::cli::train_run(o.config, column_sets(o, column), run_dir, "", true);
 }
 
 void run_experiment(const ExperimentOptions& o) {
@@ -149,6 +146,9 @@ void run_experiment(const ExperimentOptions& o) {
     std::fprintf(stderr, "experiment: column %zu/%zu: %s\n", i + 1, columns.size(), run_dir.c_str());
     ColumnTimes t;
     t.name = column.name;
+    // One writer per column for its training and its evaluations.
+    fs::create_directories(run_dir);
+    const comorph::RunLock lock(run_dir);
     if (!train_column(o, column, configs[i], run_dir, t)) {
       std::fprintf(stderr, "experiment interrupted in %s (checkpoint written); run the same command again to continue\n",
                    run_dir.c_str());
@@ -193,7 +193,7 @@ void run_experiment(const ExperimentOptions& o) {
     table_md = comorph::report::render_markdown({title, comorph::report::comparison_table(t, runs)});
   }
   const fs::path table_path = fs::path(o.out) / fmt::format("table-{}.md", o.table);
-  write_text(table_path, table_md);
+  comorph::write_file_atomic(table_path.string(), table_md);
 
   std::printf("\n%s\n", table_md.c_str());
   std::printf("%-10s %-12s %14s %14s %12s\n", "column", "training", "train wall s", "control steps", "eval wall s");
@@ -229,7 +229,8 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   ex->add_option("--out", options.out, "experiment directory: one run directory per column, table-N.md, report/")
       ->required();
   ex->add_option("--only", options.only, "run only this column (e.g. fixed-4); the table shows what exists");
-  ex->add_option("--eval-episodes", options.eval_episodes, "evaluation episodes per scenario (default: eval.episodes)");
+  ex->add_option("--eval-episodes", options.eval_episodes, "evaluation episodes per scenario (default: eval.episodes)")
+      ->check(comorph::cli::whole_in(1, 1000000));
   ex->callback([] { run_experiment(options); });
 }};
 

@@ -27,6 +27,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "cli_numbers.hpp"
+#include "common/file_io.hpp"
 #include "command_registry.hpp"
 #include "coopt/scene_dataset.hpp"
 #include "perception/dataset.hpp"
@@ -41,6 +43,9 @@ namespace {
 
 namespace fs = std::filesystem;
 namespace perception = comorph::perception;
+namespace cli = comorph::cli;
+
+constexpr long long kMaxSeed = 1LL << 53;  // seeds every seed type here holds exactly
 
 std::string describe(const perception::Dataset& d, const perception::ClassifierParams& p) {
   std::string s = fmt::format("{} images of {}x{} pixels:", d.size(), d.height, d.width);
@@ -191,15 +196,6 @@ std::string json_delays(const perception::SwitchDelayReport& d, double max) {
       json_number(d.mean_delay()), json_number(max), d.detected, d.missed, d.false_switches);
 }
 
-void write_text_atomically(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream f(tmp);
-    f << text;
-    if (!f) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  fs::rename(tmp, path);
-}
 
 void run_prepare(const PrepareOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
@@ -306,7 +302,7 @@ void run_prepare(const PrepareOptions& o) {
     const double total_seconds = seconds_since(t_start);
     say(fmt::format("wall time: data {:.1f} s, training {:.1f} s, switch episodes {:.1f} s, total {:.1f} s\n",
                     train.stats.seconds + eval.stats.seconds, train_seconds, sw.seconds, total_seconds));
-    write_text_atomically(stage / "classifier-eval.txt", report.str());
+    comorph::write_file_atomic((stage / "classifier-eval.txt").string(), report.str());
     std::string confusion = "[";
     for (std::size_t t = 0; t < r.eval.confusion.size(); ++t) {
       confusion += t ? ", [" : "[";
@@ -315,8 +311,8 @@ void run_prepare(const PrepareOptions& o) {
       confusion += "]";
     }
     confusion += "]";
-    write_text_atomically(
-        stage / "classifier-eval.json",
+    comorph::write_file_atomic(
+        (stage / "classifier-eval.json").string(),
         fmt::format("{{\n  \"train_seeds\": [{}, {}],\n  \"eval_seeds\": [{}, {}],\n  \"train_images\": {},\n"
                     "  \"eval_images\": {},\n  \"width\": {},\n  \"epochs\": {},\n  \"eval_accuracy\": {},\n"
                     "  \"eval_accuracy_run_frames\": {},\n  \"eval_accuracy_view_frames\": {},\n"
@@ -357,8 +353,9 @@ void add_classifier_subcommands(CLI::App& app) {
   train->add_option("--out", to.out, "directory to write classifier.pt and classifier.yaml to")->required();
   train->add_option("--config", to.config, "perception preset (e.g. configs/perception.yaml)");
   train->add_option("--epochs", to.epochs, "passes over the training data (overrides the preset)")
-      ->check(CLI::PositiveNumber);
-  train->add_option("--seed", to.seed, "seed of weights, split and shuffling (overrides the preset)");
+      ->check(cli::whole_in(1, 100000));
+  train->add_option("--seed", to.seed, "seed of weights, split and shuffling (overrides the preset)")
+      ->check(cli::whole_in(0, kMaxSeed));
   train->callback([] { run_train(to); });
 
   auto* eval = cls->add_subcommand("eval", "print accuracy and the confusion matrix of a saved classifier");
@@ -368,8 +365,8 @@ void add_classifier_subcommands(CLI::App& app) {
   eval->add_option("--config", eo.config, "perception preset for the switch detector (default: built-in)");
   eval->add_option("--switch-trials", eo.switch_trials,
                    "episodes with one scene change to measure the switch delay on (0 = skip)")
-      ->check(CLI::NonNegativeNumber);
-  eval->add_option("--seed", eo.seed, "seed of the switch trials");
+      ->check(cli::whole_in(0, 1000000));
+  eval->add_option("--seed", eo.seed, "seed of the switch trials")->check(cli::whole_in(0, kMaxSeed));
   eval->callback([] { run_eval(eo); });
 
   auto* synth = cls->add_subcommand(
@@ -377,10 +374,10 @@ void add_classifier_subcommands(CLI::App& app) {
   static perception::SyntheticParams sp;
   static std::string synth_out;
   synth->add_option("--out", synth_out, "dataset file to write")->required();
-  synth->add_option("--count", sp.count, "number of images")->check(CLI::PositiveNumber);
-  synth->add_option("--size", sp.image_size, "image side, pixels")->check(CLI::Range(8, 256));
-  synth->add_option("--noise", sp.noise, "std of the depth noise, depth units")->check(CLI::Range(0.0, 1.0));
-  synth->add_option("--seed", sp.seed, "seed of the images");
+  synth->add_option("--count", sp.count, "number of images")->check(cli::whole_in(1, 10000000));
+  synth->add_option("--size", sp.image_size, "image side, pixels")->check(cli::whole_in(8, 256));
+  synth->add_option("--noise", sp.noise, "std of the depth noise, depth units")->check(cli::finite_in(0.0, 1.0));
+  synth->add_option("--seed", sp.seed, "seed of the images")->check(cli::whole_in(0, kMaxSeed));
   synth->callback([] {
     const perception::Dataset d = perception::make_synthetic_dataset(sp);
     perception::save_dataset(synth_out, d);
@@ -393,11 +390,12 @@ void add_classifier_subcommands(CLI::App& app) {
   data->add_option("--out", dop.out, "dataset file to write")->required();
   data->add_option("--seeds", dop.seeds, "scene seeds A:B, inclusive (held-out sets: a disjoint range)");
   data->add_option("--frames-per-seed", dop.frames_per_seed, "images per scene seed")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::whole_in(1, 100000));
   data->add_option("--run-fraction", dop.run_fraction,
                    "share of a seed's images from its scripted run (the rest: level views), 0..1")
-      ->check(CLI::Range(0.0, 1.0));
-  data->add_option("--seed", dop.seed, "generator seed (chain lengths, obstacle counts, frame picks, view poses)");
+      ->check(cli::finite_in(0.0, 1.0));
+  data->add_option("--seed", dop.seed, "generator seed (chain lengths, obstacle counts, frame picks, view poses)")
+      ->check(cli::whole_in(0, kMaxSeed));
   data->add_option("--config-dir", dop.config_dir, "directory of robot/scene/motion/task.yaml");
   data->callback([] { run_dataset(dop); });
 
@@ -413,12 +411,12 @@ void add_classifier_subcommands(CLI::App& app) {
                    "switch-delay episodes");
   prep->add_option("--epochs", po.epochs,
                    "passes over the training data (default 6, not the preset's: held-out accuracy plateaus after 2-3)")
-      ->check(CLI::PositiveNumber);
-  prep->add_option("--frames-per-seed", po.frames_per_seed, "images per scene seed")->check(CLI::PositiveNumber);
+      ->check(cli::whole_in(1, 100000));
+  prep->add_option("--frames-per-seed", po.frames_per_seed, "images per scene seed")->check(cli::whole_in(1, 100000));
   prep->add_option("--run-fraction", po.run_fraction,
                    "share of a seed's images from its scripted run (the rest: level views), 0..1")
-      ->check(CLI::Range(0.0, 1.0));
-  prep->add_option("--seed", po.seed, "generator seed of the data and the episodes");
+      ->check(cli::finite_in(0.0, 1.0));
+  prep->add_option("--seed", po.seed, "generator seed of the data and the episodes")->check(cli::whole_in(0, kMaxSeed));
   prep->add_option("--config-dir", po.config_dir, "directory of robot/scene/motion/task.yaml");
   prep->callback([] { run_prepare(po); });
 }

@@ -19,6 +19,7 @@
 
 #include <fmt/format.h>
 
+#include "cli_numbers.hpp"
 #include "command_registry.hpp"
 #include "coopt/config.hpp"
 #include "coopt/trainer.hpp"
@@ -185,16 +186,23 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   render->add_option("--run", request.run_dir, "run directory (config.yaml, checkpoint/)")->required();
   auto* seed = render->add_option("--seed", request.seed,
                      "episode seed; eval.seed + i is evaluation episode i (default: eval.seed, episode 0)");
-  auto* height = render->add_option("--stair-height", request.stair_height_m, "stair height, m (default: the episode's)");
+  auto* height = render->add_option("--stair-height", request.stair_height_m, "stair height, m (default: the episode's)")
+                     ->check(comorph::cli::finite_in(0, 0.3));
   render->add_option("--scenario", request.scenario, "default | obstacles7 | obstacles8 | mixed")
       ->capture_default_str();
   render->add_option("--out,-o", request.out, "video file (.mp4); the strip goes to <out>-strip.png")->required();
-  render->add_option("--width", request.options.width, "frame width, pixels")->capture_default_str();
-  render->add_option("--height", request.options.height, "frame height, pixels")->capture_default_str();
+  render->add_option("--width", request.options.width, "frame width, pixels")
+      ->capture_default_str()
+      ->check(comorph::cli::whole_in(16, 8192));
+  render->add_option("--height", request.options.height, "frame height, pixels")
+      ->capture_default_str()
+      ->check(comorph::cli::whole_in(16, 8192));
   render->add_option("--max-frames", request.options.max_frames, "stop after this many frames")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(comorph::cli::whole_in(1, 10000000));
   render->add_option("--frame-step", request.frame_step, "draw every Nth control step (fps divided by N)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(comorph::cli::whole_in(1, 100000));
   render->callback([seed, height] { render_run(request, seed->count() > 0, height->count() > 0); });
 }};
 

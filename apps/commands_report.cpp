@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "cli_numbers.hpp"
 #include "command_registry.hpp"
 #include "report/metrics.hpp"
 #include "report/render_episode.hpp"
@@ -30,7 +31,8 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   report->add_option("--out,-o", options.out_dir, "output directory (created)")->required();
   report->add_option("--reference", options.reference_path, "paper tables YAML (default: configs/reference/paper-tables.yaml)");
   report->add_option("--window", options.curve_window, "episodes in the training curves' moving averages")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(comorph::cli::whole_in(1, 1000000));
   report->callback([] {
     const auto result = comorph::report::write_report(runs, options);
     std::cout << "wrote " << result.markdown_path << ", " << result.html_path << " and " << result.images.size()
@@ -44,12 +46,16 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   static comorph::task::ObjectiveWeights weights;
   summarize->add_option("episodes", episodes_csv, "episode CSV (docs/report.md)")->required()->check(CLI::ExistingFile);
   summarize->add_option("--out,-o", json_out, "JSON to write (default: print it)");
-  summarize->add_option("--w-t", weights.w_t, "F(H) weight of time")->capture_default_str();
-  summarize->add_option("--w-e", weights.w_e, "F(H) weight of energy")->capture_default_str();
-  summarize->add_option("--w-d", weights.w_d, "F(H) weight of distance")->capture_default_str();
-  summarize->add_option("--t-max", weights.t_max_s, "time that makes T = 1, seconds")->capture_default_str();
+  // The ranges of env.task.objective (task/env_config.cpp).
+  summarize->add_option("--w-t", weights.w_t, "F(H) weight of time")->capture_default_str()->check(comorph::cli::finite_in(0, 100));
+  summarize->add_option("--w-e", weights.w_e, "F(H) weight of energy")->capture_default_str()->check(comorph::cli::finite_in(0, 100));
+  summarize->add_option("--w-d", weights.w_d, "F(H) weight of distance")->capture_default_str()->check(comorph::cli::finite_in(0, 100));
+  summarize->add_option("--t-max", weights.t_max_s, "time that makes T = 1, seconds")
+      ->capture_default_str()
+      ->check(comorph::cli::finite_in(1e-3, 1e6));
   summarize->add_option("--energy-scale", weights.energy_scale_J, "energy that makes E = 1, joules")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(comorph::cli::finite_in(1e-3, 1e9));
   summarize->callback([] {
     const auto metrics = comorph::report::summarize(comorph::report::read_episodes_csv(episodes_csv), weights);
     if (json_out.empty()) {
@@ -70,14 +76,17 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   static comorph::report::RenderOptions ropt;
   render->add_option("--mjcf", mjcf, "MJCF file")->required()->check(CLI::ExistingFile);
   render->add_option("--out,-o", out, "video file (.mp4); the strip goes to <out>-strip.png")->required();
-  render->add_option("--frames", frames, "frames to render")->capture_default_str();
-  render->add_option("--width", ropt.width, "frame width, pixels")->capture_default_str();
-  render->add_option("--height", ropt.height, "frame height, pixels")->capture_default_str();
-  render->add_option("--fps", ropt.video.fps, "video frames a second")->capture_default_str();
+  render->add_option("--frames", frames, "frames to render")->capture_default_str()->check(comorph::cli::whole_in(1, 1000000));
+  render->add_option("--width", ropt.width, "frame width, pixels")->capture_default_str()->check(comorph::cli::whole_in(16, 8192));
+  render->add_option("--height", ropt.height, "frame height, pixels")->capture_default_str()->check(comorph::cli::whole_in(16, 8192));
+  render->add_option("--fps", ropt.video.fps, "video frames a second")->capture_default_str()->check(comorph::cli::finite_in(1, 1000));
   render->add_option("--steps-per-frame", steps_per_frame,
-                     "physics steps between frames (default: as many as make 1/fps seconds)");
+                     "physics steps between frames (default: as many as make 1/fps seconds)")
+      ->check(comorph::cli::whole_in(1, 1000000));
   render->add_option("--track", ropt.camera.track_body, "body the camera follows (default: free camera)");
-  render->add_option("--distance", ropt.camera.distance_m, "camera distance, metres")->capture_default_str();
+  render->add_option("--distance", ropt.camera.distance_m, "camera distance, metres")
+      ->capture_default_str()
+      ->check(comorph::cli::finite_in(0.01, 1000));
   render->add_option("--codec", ropt.video.codec, "ffmpeg video encoder (libx264, mpeg4)")->capture_default_str();
   render->callback([] {
     char error[1000] = "";

@@ -4,6 +4,7 @@
 
 #include <iostream>
 
+#include "cli_numbers.hpp"
 #include "command_registry.hpp"
 #include "rl/learner.hpp"
 #include "rl/train_classic.hpp"
@@ -23,14 +24,20 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   cmd->add_option("--algo", options.algorithm, "td3 | sac | dqn")
       ->required()
       ->check(CLI::IsMember({"td3", "sac", "dqn"}));
-  cmd->add_option("--steps", options.steps, "training environment steps")->required();
-  cmd->add_option("--seed", options.seed, "random seed (env, learner, networks)")->required();
+  cmd->add_option("--steps", options.steps, "training environment steps")
+      ->required()
+      ->check(comorph::cli::whole_in(1, 1000000000));
+  cmd->add_option("--seed", options.seed, "random seed (env, learner, networks)")
+      ->required()
+      ->check(comorph::cli::whole_in(0, 2000000000));
   cmd->add_option("--config", options.config_path,
                   "hyperparameter YAML (default: configs/rl/<env>_<algo>.yaml)");
   cmd->add_option("--eval-episodes", options.eval_episodes, "greedy evaluation episodes")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(comorph::cli::whole_in(1, 1000000));
   cmd->add_option("--threads", threads, "torch intra-op threads (1 is fastest for these nets)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(comorph::cli::whole_in(1, 64));
   cmd->add_flag("--json", json, "print one JSON object: mean_return, std_return, steps_per_s, wall_s");
   cmd->callback([] {
     comorph::rl::set_torch_threads(threads, 1);

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <stdexcept>
 
+#include "cli_numbers.hpp"
 #include "command_registry.hpp"
 #include "sim/mjcf.hpp"
 #include "sim/model.hpp"
@@ -32,6 +33,11 @@ struct SimOptions {
 };
 
 task::EnvConfig load_config(const std::string& dir) { return task::load_env_config(dir); }
+
+// Limits of the scene options: the stair heights of configs/sim/scene.yaml
+// (0..0.3 m) and seeds that every seed type in the scene code holds exactly.
+constexpr double kMaxStairHeight = 0.3;
+constexpr long long kMaxSeed = 1LL << 53;
 
 std::string num(double v, int digits) {
   return std::isnan(v) ? std::string("-") : fmt::format("{:.{}f}", v, digits);
@@ -160,9 +166,10 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   static SimOptions o;
   auto* exp = app.add_subcommand("export-mjcf", "write the scene with a chain robot as MJCF to stdout");
   exp->add_option("--modules,-n", o.modules, "number of modules (2..10)")->check(CLI::Range(2, 10));
-  exp->add_option("--stair-height", o.stair_height, "m, step height (0 = drawn from the seed)");
-  exp->add_option("--obstacles", o.obstacles, "K obstacles (-1 = scene default)");
-  exp->add_option("--seed", o.seed, "scene seed");
+  exp->add_option("--stair-height", o.stair_height, "m, step height (0 = drawn from the seed)")
+      ->check(cli::finite_in(0, kMaxStairHeight));
+  exp->add_option("--obstacles", o.obstacles, "K obstacles (-1 = scene default)")->check(cli::whole_in(-1, 50));
+  exp->add_option("--seed", o.seed, "scene seed")->check(cli::whole_in(0, kMaxSeed));
   exp->add_option("--variant", o.variant, "standard | mixed");
   exp->add_option("--config-dir", o.config_dir, "directory of robot/scene/motion/task.yaml");
   exp->callback([] { run_export(o); });
@@ -177,11 +184,13 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
 
   auto* demo = app.add_subcommand("demo", "a scripted controller drives the robot through the scenario");
   demo->add_option("--modules,-n", o.modules, "number of modules (2..10)")->check(CLI::Range(2, 10));
-  demo->add_option("--seed", o.seed, "scene seed");
-  demo->add_option("--stair-height", o.stair_height, "m, step height (0 = drawn from the seed)");
-  demo->add_option("--obstacles", o.obstacles, "K obstacles (-1 = scene default)");
+  demo->add_option("--seed", o.seed, "scene seed")->check(cli::whole_in(0, kMaxSeed));
+  demo->add_option("--stair-height", o.stair_height, "m, step height (0 = drawn from the seed)")
+      ->check(cli::finite_in(0, kMaxStairHeight));
+  demo->add_option("--obstacles", o.obstacles, "K obstacles (-1 = scene default)")->check(cli::whole_in(-1, 50));
   demo->add_option("--variant", o.variant, "standard | mixed");
-  demo->add_option("--shed-to", o.shed_to, "after the stairs, shed tail modules down to this many (0 = keep)");
+  demo->add_option("--shed-to", o.shed_to, "after the stairs, shed tail modules down to this many (0 = keep)")
+      ->check(cli::whole_in(0, 10));
   demo->add_option("--config-dir", o.config_dir, "directory of robot/scene/motion/task.yaml");
   demo->callback([] { run_demo(o); });
 }};

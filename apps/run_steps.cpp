@@ -9,9 +9,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -21,6 +23,8 @@
 #include "report/episode_record.hpp"
 #include "report/metrics.hpp"
 #include "report/run_dir.hpp"
+#include "common/file_io.hpp"
+#include "common/run_lock.hpp"
 #include "common/yaml_fields.hpp"
 
 namespace comorph::cli {
@@ -43,13 +47,14 @@ void append_episode(const std::string& path, const EpisodeLog& log) {
   std::ostringstream s;
   comorph::report::write_episodes_csv(s, {to_record(log)});
   const std::string text = s.str();
-  std::ofstream out(path, std::ios::app);
-  out << text.substr(text.find('\n') + 1);
-  if (!out) throw std::runtime_error("cannot append to " + path);
+  append_file(path, text.substr(text.find('\n') + 1));
 }
 
 // F(H) as the env defines it (task/rewards.hpp, env.task.objective in the config).
 const comorph::task::ObjectiveWeights& f_weights(const CooptConfig& c) { return c.env.task.objective; }
+
+// Largest episodes.csv / evaluations.csv resume reads (4300 episodes take ~0.5 MB).
+constexpr std::size_t kMaxRunCsvBytes = 256u << 20;
 
 const char* kEvalColumns =
     "train_episode,env_steps,wall_s,episodes,success_0.04,success_0.06,success_0.08,success_avg,"
@@ -74,12 +79,13 @@ void append_evaluation(const std::string& path, const CooptConfig& c, const como
       first = false;
     }
   }
-  std::ofstream out(path, std::ios::app);
+  std::ostringstream out;
   out << e.train_episode << ',' << e.env_steps << ',' << fmt::format("{:.1f}", e.wall_s) << ',' << e.episodes.size()
       << ',' << format_rate(m.success_rate.at("0.04")) << ',' << format_rate(m.success_rate.at("0.06")) << ','
       << format_rate(m.success_rate.at("0.08")) << ',' << format_rate(m.success_rate.at("avg")) << ','
       << fmt::format("{:.2f}", ret / n) << ',' << fmt::format("{:.3f}", dist / n) << ','
       << fmt::format("{:.3f}", m.F) << ',' << configs << '\n';
+  append_file(path, out.str());
   std::fprintf(stderr,
                "evaluation after %d episodes: success 0.04/0.06/0.08 m = %s/%s/%s (avg %s), return %.1f, "
                "distance %.0f %%, configurations %s\n",
@@ -88,25 +94,97 @@ void append_evaluation(const std::string& path, const CooptConfig& c, const como
                100.0 * dist / n, configs.c_str());
 }
 
+// Data lines of a CSV file after its header (a missing file has none).
+std::vector<std::string> csv_data_lines(const std::string& path, std::string& header) {
+  std::vector<std::string> lines;
+  if (!fs::exists(path)) return lines;
+  std::istringstream in(read_text_file(path, kMaxRunCsvBytes));
+  std::getline(in, header);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// Resume continues episodes.csv and evaluations.csv after the rows the
+// checkpoint counts (later rows come from after it and are dropped). Those
+// rows must all be there and be rows of these files: a shorter file would
+// leave a permanent gap, a garbled one would be kept and appended to.
+void check_rows_for_resume(const std::string& episodes_csv, const std::string& evaluations_csv,
+                           const comorph::coopt::CheckpointInfo& checkpoint) {
+  std::string header;
+  const auto episodes = csv_data_lines(episodes_csv, header);
+  if (static_cast<int>(episodes.size()) < checkpoint.episodes)
+    throw std::runtime_error(fmt::format(
+        "{}: {} rows, but the checkpoint ({}) counts {} episodes; refusing to resume with a gap", episodes_csv,
+        episodes.size(), checkpoint.directory, checkpoint.episodes));
+  std::string kept = header + "\n";
+  for (int i = 0; i < checkpoint.episodes; ++i) kept += episodes[static_cast<std::size_t>(i)] + "\n";
+  std::istringstream rows(kept);
+  std::vector<comorph::report::EpisodeRecord> records;
+  try {
+    records = comorph::report::read_episodes_csv(rows, episodes_csv);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(std::string(e.what()) + "; refusing to resume from a damaged episodes.csv");
+  }
+  for (int i = 0; i < checkpoint.episodes; ++i)
+    if (records[static_cast<std::size_t>(i)].episode != i)
+      throw std::runtime_error(fmt::format("{}:{}: episode {} where episode {} belongs; refusing to resume",
+                                           episodes_csv, i + 2, records[static_cast<std::size_t>(i)].episode, i));
+
+  const auto evaluations = csv_data_lines(evaluations_csv, header);
+  const std::string columns = std::string(kEvalColumns).substr(0, std::string(kEvalColumns).size() - 1);
+  if (checkpoint.evaluations > 0 && header != columns)
+    throw std::runtime_error(evaluations_csv + ":1: not the header of evaluations.csv; refusing to resume");
+  if (static_cast<int>(evaluations.size()) < checkpoint.evaluations)
+    throw std::runtime_error(fmt::format(
+        "{}: {} rows, but the checkpoint ({}) counts {} evaluations; refusing to resume with a gap",
+        evaluations_csv, evaluations.size(), checkpoint.directory, checkpoint.evaluations));
+  const auto fields = std::count(columns.begin(), columns.end(), ',') + 1;
+  for (int i = 0; i < checkpoint.evaluations; ++i) {
+    const std::string& row = evaluations[static_cast<std::size_t>(i)];
+    if (std::count(row.begin(), row.end(), ',') + 1 != fields || row.empty() ||
+        row.find_first_not_of("0123456789") != row.find(','))
+      throw std::runtime_error(fmt::format("{}:{}: not a row of evaluations.csv ('{}'); refusing to resume",
+                                           evaluations_csv, i + 2, quote_value(row)));
+  }
+}
+
 }  // namespace
 
+bool is_empty_run_dir(const std::string& dir) {
+  if (!fs::exists(dir)) return true;
+  if (!fs::is_directory(dir)) return false;
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.path().filename() != RunLock::kFileName) return false;
+  return true;
+}
+
+void clear_run_dir(const std::string& dir) {
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.path().filename() != RunLock::kFileName) fs::remove_all(entry.path());
+}
+
 bool train_run(const std::string& config_path, const std::vector<std::string>& sets, const std::string& out,
-               const std::string& resume) {
+               const std::string& resume, bool locked_by_caller) {
   std::string run_dir;
   CooptConfig config;
+  std::unique_ptr<RunLock> lock;  // one writer per run directory, for the whole training
+  comorph::coopt::CheckpointInfo checkpoint;
   if (!resume.empty()) {
     if (!config_path.empty() || !sets.empty())
       throw std::runtime_error("--resume takes the run's own config.yaml; drop --config/--set");
     run_dir = resume;
+    if (!fs::is_directory(run_dir)) throw std::runtime_error(run_dir + ": no such run directory");
+    // Before anything is read: another writer may be in the middle of a checkpoint.
+    if (!locked_by_caller) lock = std::make_unique<RunLock>(run_dir);
     const std::string path = (fs::path(run_dir) / "config.yaml").string();
     if (!fs::exists(path)) throw std::runtime_error(run_dir + ": not a training run (no config.yaml)");
     config = comorph::coopt::load_coopt_config(path);
-    comorph::coopt::read_checkpoint_info(run_dir);  // throws when there is no checkpoint
+    checkpoint = comorph::coopt::read_checkpoint_info(run_dir);  // throws when there is no checkpoint
   } else {
     if (config_path.empty()) throw std::runtime_error("train: give --config FILE (or --resume runs/NAME)");
     if (out.empty()) throw std::runtime_error("train: give --out runs/NAME");
     config = comorph::coopt::load_coopt_config(config_path, sets);
-    if (fs::exists(out) && !fs::is_empty(out))
+    if (!is_empty_run_dir(out))
       throw std::runtime_error(out + " exists and is not empty (use --resume " + out + " to continue it)");
     run_dir = out;
   }
@@ -122,7 +200,12 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
 
   if (resume.empty()) {
     fs::create_directories(run_dir);
-    std::ofstream(fs::path(run_dir) / "config.yaml") << config.text << "\n";
+    if (!locked_by_caller) lock = std::make_unique<RunLock>(run_dir);
+    // A second `train --out` of the same directory may have passed the check
+    // above too; the one that locked first owns it.
+    if (!is_empty_run_dir(run_dir))
+      throw std::runtime_error(run_dir + " was filled by another process meanwhile; refusing to write into it");
+    write_file_atomic((fs::path(run_dir) / "config.yaml").string(), config.text + "\n");
     comorph::report::RunInfo info;
     info.name = fs::path(run_dir).filename().string();
     info.kind = config.trainer.mode;
@@ -134,8 +217,9 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
     info.notes = "scene source: " + config.trainer.scene_source;
     comorph::report::write_run_info((fs::path(run_dir) / "run.yaml").string(), info);
     comorph::report::write_episodes_csv(episodes_csv, {});
-    std::ofstream(evaluations_csv) << kEvalColumns;
+    write_file_atomic(evaluations_csv, kEvalColumns);
   } else {
+    check_rows_for_resume(episodes_csv, evaluations_csv, checkpoint);
     trainer.resume();
     std::fprintf(stderr, "resuming %s after %d episodes (%lld control steps)\n", run_dir.c_str(),
                  trainer.episodes_done(), static_cast<long long>(trainer.env_steps()));

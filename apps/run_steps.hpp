@@ -13,9 +13,17 @@ namespace comorph::cli {
 // Trains a new run into `out` (config file + `--set`s) or, when `resume` is
 // given, continues that run from its last checkpoint. SIGINT/SIGTERM finish
 // the current episode and write a checkpoint; returns false then, true when
-// every episode is done.
+// every episode is done. The run directory is locked (common/run_lock.hpp)
+// for the whole training unless `locked_by_caller` (`comorph experiment`
+// holds the column's lock itself). A resume is refused when episodes.csv or
+// evaluations.csv lack rows the checkpoint counts or have damaged ones.
 bool train_run(const std::string& config_path, const std::vector<std::string>& sets, const std::string& out,
-               const std::string& resume);
+               const std::string& resume, bool locked_by_caller = false);
+
+// True when `dir` is missing or holds nothing but a run lock file.
+bool is_empty_run_dir(const std::string& dir);
+// Removes everything in `dir` but the lock file (that a caller may hold).
+void clear_run_dir(const std::string& dir);
 
 // Greedy evaluation of a trained run on the paper's protocol: writes
 // eval-<scenario>.json and eval-<scenario>-episodes.csv into the run

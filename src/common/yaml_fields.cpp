@@ -1,6 +1,6 @@
 #include "common/yaml_fields.hpp"
 
-#include <fstream>
+#include <set>
 
 namespace comorph {
 
@@ -28,33 +28,41 @@ void YamlFields::apply(const YAML::Node& map, const std::string& prefix) const {
   }
 }
 
-void YamlFields::apply_text(const std::string& text) const {
+void YamlFields::apply_text(const std::string& text) const { apply(parse_yaml(text, source_)); }
+
+namespace {
+
+// Throws on the first mapping (at any depth) that has a key twice.
+void check_unique_keys(const YAML::Node& node, const std::string& source) {
+  if (node.IsSequence()) {
+    for (const auto& item : node) check_unique_keys(item, source);
+    return;
+  }
+  if (!node.IsMap()) return;
+  std::set<std::string> seen;
+  for (const auto& item : node) {
+    const std::string key = item.first.IsScalar() ? item.first.Scalar() : YAML::Dump(item.first);
+    if (!seen.insert(key).second)
+      throw std::runtime_error(source + ": key '" + quote_value(key) + "' appears twice in one mapping (line " +
+                               std::to_string(item.first.Mark().line + 1) + ")");
+    check_unique_keys(item.second, source);
+  }
+}
+
+}  // namespace
+
+YAML::Node parse_yaml(const std::string& text, const std::string& source) {
   YAML::Node root;
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw std::runtime_error(source_ + ": not valid YAML: " + e.msg + " (line " +
-                             std::to_string(e.mark.line + 1) + ")");
+    throw std::runtime_error(source + ": not valid YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) +
+                             ")");
   }
-  apply(root);
+  check_unique_keys(root, source);
+  return root;
 }
 
-std::string read_text_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open file");
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
-
-YAML::Node load_yaml_file(const std::string& path) {
-  const std::string text = read_text_file(path);
-  try {
-    return YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": not valid YAML: " + e.msg + " (line " +
-                             std::to_string(e.mark.line + 1) + ")");
-  }
-}
+YAML::Node load_yaml_file(const std::string& path) { return parse_yaml(read_text_file(path), path); }
 
 }  // namespace comorph

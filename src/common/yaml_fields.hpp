@@ -13,6 +13,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "common/file_io.hpp"  // read_text_file, quote_value
+
 #include <functional>
 #include <sstream>
 #include <stdexcept>
@@ -54,7 +56,7 @@ class YamlFields {
   void apply_text(const std::string& text) const;
 
   [[noreturn]] void fail(const std::string& field, const std::string& what) const {
-    throw std::runtime_error(source_ + ": field '" + field + "': " + what);
+    throw std::runtime_error(source_ + ": field '" + quote_value(field) + "': " + what);
   }
   const std::string& source() const { return source_; }
 
@@ -64,7 +66,7 @@ class YamlFields {
     try {
       return node.as<T>();
     } catch (const YAML::Exception&) {
-      fail(key, "bad value '" + YAML::Dump(node) + "'");
+      fail(key, "bad value '" + quote_value(YAML::Dump(node)) + "'");
     }
   }
 
@@ -76,9 +78,11 @@ class YamlFields {
   std::vector<Field> fields_;
 };
 
-// Reads a whole file; throws std::runtime_error naming the file when it cannot.
-std::string read_text_file(const std::string& path);
-// Parses a YAML file; errors name the file (and the line of a syntax error).
+// Parses YAML text; errors name `source` (and the line of a syntax error). A
+// key that appears twice in one mapping is an error (yaml-cpp would keep one
+// of them without a word).
+YAML::Node parse_yaml(const std::string& text, const std::string& source);
+// parse_yaml of a file (read_text_file: size cap, not a directory).
 YAML::Node load_yaml_file(const std::string& path);
 
 }  // namespace comorph

@@ -13,14 +13,15 @@ namespace comorph::coopt {
 namespace {
 
 [[noreturn]] void fail(const std::string& source, const std::string& key, const std::string& what) {
-  throw std::runtime_error(source + ": field '" + key + "': " + what);
+  throw std::runtime_error(source + ": field '" + quote_value(key) + "': " + what);
 }
 
 // Sets root[a][b][c] = value for "a.b.c=value" (maps created as needed).
 void apply_set(YAML::Node& root, const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
-    throw std::runtime_error("--set '" + assignment + "': expected key=value (dotted key, e.g. trainer.episodes=10)");
+    throw std::runtime_error("--set '" + quote_value(assignment) +
+                             "': expected key=value (dotted key, e.g. trainer.episodes=10)");
   const std::string key = assignment.substr(0, eq);
   const std::string value = assignment.substr(eq + 1);
   std::vector<std::string> parts;
@@ -28,16 +29,11 @@ void apply_set(YAML::Node& root, const std::string& assignment) {
   while (true) {
     const auto dot = key.find('.', start);
     parts.push_back(key.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
-    if (parts.back().empty()) throw std::runtime_error("--set '" + assignment + "': empty key component");
+    if (parts.back().empty()) throw std::runtime_error("--set '" + quote_value(assignment) + "': empty key component");
     if (dot == std::string::npos) break;
     start = dot + 1;
   }
-  YAML::Node parsed;
-  try {
-    parsed = YAML::Load(value);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error("--set " + key + ": value '" + value + "' is not valid YAML: " + e.msg);
-  }
+  const YAML::Node parsed = parse_yaml(value, "--set " + quote_value(key) + " value '" + quote_value(value) + "'");
   YAML::Node node = root;
   for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
     YAML::Node child = node[parts[i]];
@@ -45,7 +41,8 @@ void apply_set(YAML::Node& root, const std::string& assignment) {
       node[parts[i]] = YAML::Node(YAML::NodeType::Map);
       child = node[parts[i]];
     }
-    if (!child.IsMap()) throw std::runtime_error("--set " + key + ": '" + parts[i] + "' is not a section");
+    if (!child.IsMap())
+      throw std::runtime_error("--set " + quote_value(key) + ": '" + quote_value(parts[i]) + "' is not a section");
     node.reset(child);
   }
   node[parts.back()] = parsed;
@@ -72,7 +69,7 @@ void read_scalar(const YAML::Node& section, const std::string& source, const std
   try {
     field = v.as<T>();
   } catch (const YAML::Exception&) {
-    fail(source, prefix + "." + key, "bad value '" + v.Scalar() + "'");
+    fail(source, prefix + "." + key, "bad value '" + quote_value(v.Scalar()) + "'");
   }
 }
 
@@ -82,7 +79,7 @@ void one_of(const std::string& source, const std::string& key, const std::string
     if (a == value) return;
   std::string list;
   for (const auto& a : allowed) list += (list.empty() ? "" : " | ") + a;
-  fail(source, key, "'" + value + "' is not one of " + list);
+  fail(source, key, "'" + quote_value(value) + "' is not one of " + list);
 }
 
 std::string dump(const YAML::Node& n) {
@@ -148,11 +145,14 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   one_of(source, pre + ".scene_source", p.scene_source, {"ground_truth", "classifier"});
   one_of(source, pre + ".scenario", p.scenario, {"default", "obstacles7", "obstacles8", "mixed"});
   one_of(source, pre + ".warmup_policy", p.warmup_policy, {"random", "scripted"});
+  // A run without a single episode would end at once with no checkpoint to resume or evaluate.
+  if (p.warmup_episodes + p.episodes < 1)
+    fail(source, pre + ".episodes", "warmup_episodes + episodes must be at least 1");
   if (p.scene_source == "classifier") {
     if (p.classifier_dir.empty())
       fail(source, pre + ".classifier_dir", "scene_source: classifier needs the directory of a trained classifier");
     if (!std::filesystem::exists(std::filesystem::path(p.classifier_dir) / "classifier.pt"))
-      fail(source, pre + ".classifier_dir", "no classifier.pt in '" + p.classifier_dir +
+      fail(source, pre + ".classifier_dir", "no classifier.pt in '" + quote_value(p.classifier_dir) +
                                                 "' (train one with `comorph classifier train`)");
   }
   return p;
@@ -189,17 +189,12 @@ void scenario_settings(const std::string& scenario, int& obstacles, bool& mixed)
   if (scenario == "obstacles7") obstacles = 7;
   else if (scenario == "obstacles8") obstacles = 8;
   else if (scenario == "mixed") mixed = true;
-  else throw std::runtime_error("unknown scenario '" + scenario + "' (default | obstacles7 | obstacles8 | mixed)");
+  else throw std::runtime_error("unknown scenario '" + quote_value(scenario) + "' (default | obstacles7 | obstacles8 | mixed)");
 }
 
 CooptConfig coopt_config_from_text(const std::string& text, const std::string& source,
                                    const std::vector<std::string>& sets) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(source + ": not valid YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
-  }
+  YAML::Node root = parse_yaml(text, source);  // also refuses a key given twice
   if (!root || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
   if (!root.IsMap()) throw std::runtime_error(source + ": expected a mapping of sections");
   for (const auto& s : sets) apply_set(root, s);
@@ -212,6 +207,8 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
   const std::string env_dir =
       c.trainer.env_dir.empty() ? std::string(COMORPH_SOURCE_DIR) + "/configs/sim" : c.trainer.env_dir;
   c.env = read_env(root["env"], src, env_dir);
+  c.env_dir = env_dir;
+  c.env_text = task::env_files_text(env_dir);
   c.perception = perception::perception_config_from_yaml(root["perception"], src + ": perception");
   if (const std::string e = c.perception.switch_detector.validate(); !e.empty())
     throw std::runtime_error(src + ": perception.switch_detector: " + e);
@@ -222,17 +219,26 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
     throw std::runtime_error(src + ": env.robot: depth images must be square for the CNN encoders");
 
   // Learner sections: parsed now so that a misspelt hyperparameter stops the
-  // run before anything is written.
+  // run before anything is written. The sections of the learners this run
+  // uses must be there: their defaults are not a run's hyperparameters (and
+  // td3's default random_action_steps would be refused below).
+  const auto require_section = [&](const std::string& name, const std::string& needed_by, const std::string& what) {
+    if (!root[name] || root[name].IsNull())
+      throw std::runtime_error(src + ": no '" + name + ":' section: " + needed_by + " needs the " + what +
+                               "'s hyperparameters there (configs/quick.yaml has them)");
+  };
+  require_section(c.trainer.motion_algo, "trainer.motion_algo " + c.trainer.motion_algo, "motion model");
+  if (c.trainer.mode == "hierarchical") require_section("dqn", "trainer.mode hierarchical", "configuration model");
   c.td3_yaml = dump(root["td3"]);
   c.sac_yaml = dump(root["sac"]);
   c.dqn_yaml = dump(root["dqn"]);
   const rl::Td3Config td3 = rl::Td3Config::from_yaml(YAML::Load(c.td3_yaml), src + ": td3");
   const rl::SacConfig sac = rl::SacConfig::from_yaml(YAML::Load(c.sac_yaml), src + ": sac");
   rl::DqnConfig::from_yaml(YAML::Load(c.dqn_yaml), src + ": dqn");
-  if (td3.random_action_episodes != 0 || td3.random_action_steps != 0)
+  if (!c.td3_yaml.empty() && (td3.random_action_episodes != 0 || td3.random_action_steps != 0))
     throw std::runtime_error(src + ": field 'td3.random_action_episodes/steps': must be 0, "
                                    "the warm-up is trainer.warmup_episodes (both models)");
-  if (sac.random_action_episodes != 0 || sac.random_action_steps != 0)
+  if (!c.sac_yaml.empty() && (sac.random_action_episodes != 0 || sac.random_action_steps != 0))
     throw std::runtime_error(src + ": field 'sac.random_action_episodes/steps': must be 0, "
                                    "the warm-up is trainer.warmup_episodes (both models)");
   c.text = dump(root);

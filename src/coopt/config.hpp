@@ -88,6 +88,10 @@ struct CooptConfig {
   // The merged YAML (file + --set): what the run directory's config.yaml holds
   // and what a checkpoint is compared against.
   std::string text;
+  // The simulator config files the env was built from (task::env_files_text
+  // of env_dir): the other half of a run's identity, compared on resume.
+  std::string env_text;
+  std::string env_dir;                         // trainer.env_dir, or <source>/configs/sim
   std::string preset;                          // file stem, e.g. "quick"
 };
 

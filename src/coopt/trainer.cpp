@@ -15,6 +15,8 @@
 #include <sstream>
 #include <thread>
 
+#include "common/checksum.hpp"
+#include "common/file_io.hpp"
 #include "coopt/segment.hpp"
 #include "perception/scene_classifier.hpp"
 #include "perception/scene_monitor.hpp"
@@ -421,11 +423,25 @@ struct Transition {
 
 std::string checkpoint_dir(const std::string& run) { return (fs::path(run) / "checkpoint").string(); }
 
-void write_text_file(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::trunc);
-  out << text;
-  out.flush();
-  if (!out) throw std::runtime_error("cannot write " + path);
+void write_text_file(const std::string& path, const std::string& text) { write_file_atomic(path, text); }
+
+// Loads one checkpoint file into a learner. LibTorch's errors (a C++ backtrace
+// of 20 lines) become one line naming the file.
+template <class Model>
+void load_checkpoint_file(Model& model, const std::string& path) {
+  try {
+    model.load(path);
+  } catch (const c10::Error& e) {
+    const std::string what = e.what_without_backtrace();
+    throw std::runtime_error(path + ": cannot load: " + quote_value(what.substr(0, what.find('\n')), 200));
+  }
+}
+
+// The files of a checkpoint directory (all but checksums.txt).
+std::vector<std::string> checkpoint_files(bool with_config_model) {
+  std::vector<std::string> names{"motion.pt", "motion_actor.pt", "trainer.yaml"};
+  if (with_config_model) names.push_back("config_model.pt");
+  return names;
 }
 
 std::string first_difference(const std::string& a, const std::string& b) {
@@ -438,8 +454,8 @@ std::string first_difference(const std::string& a, const std::string& b) {
     ++line;
     if (!ga && !gb) return "";
     if (!ga || !gb || la != lb)
-      return "line " + std::to_string(line) + ": checkpoint has '" + (gb ? lb : "<end>") + "', config has '" +
-             (ga ? la : "<end>") + "'";
+      return "line " + std::to_string(line) + ": checkpoint has '" + quote_value(gb ? lb : "<end>") +
+             "', config has '" + quote_value(ga ? la : "<end>") + "'";
   }
 }
 
@@ -448,26 +464,75 @@ std::string first_difference(const std::string& a, const std::string& b) {
 // ---------------------------------------------------------------------------
 
 CheckpointInfo read_checkpoint_info(const std::string& run_dir) {
-  std::string dir = checkpoint_dir(run_dir);
-  // A crash between the two renames of a checkpoint leaves only checkpoint.old.
-  if (!fs::exists(fs::path(dir) / "trainer.yaml") && fs::exists(fs::path(dir + ".old") / "trainer.yaml"))
-    dir += ".old";
-  const std::string path = (fs::path(dir) / "trainer.yaml").string();
-  if (!fs::exists(path)) throw std::runtime_error(run_dir + ": no checkpoint (expected " + path + ")");
-  YAML::Node n;
-  try {
-    n = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": unreadable checkpoint: " + e.what());
+  // checkpoint/ is the newest; checkpoint.old/ the one before it (and the only
+  // one after a crash between the two renames of save_checkpoint). The first
+  // whose files all match their checksums is used; a damaged one is named.
+  std::string dir, problems;
+  for (const std::string& candidate : {checkpoint_dir(run_dir), checkpoint_dir(run_dir) + ".old"}) {
+    if (!fs::exists(candidate)) continue;
+    std::string problem;
+    if (!fs::exists(fs::path(candidate) / "trainer.yaml")) {
+      problem = candidate + ": incomplete (no trainer.yaml)";
+    } else if (!fs::exists(fs::path(candidate) / kChecksumFile)) {
+      std::fprintf(stderr, "comorph: warning: %s has no %s (written before checkpoints had checksums): not verified\n",
+                   candidate.c_str(), kChecksumFile);
+    } else {
+      problem = verify_checksums(candidate);
+    }
+    if (problem.empty()) {
+      dir = candidate;
+      break;
+    }
+    problems += (problems.empty() ? "" : "; ") + problem;
   }
+  if (dir.empty())
+    throw std::runtime_error(problems.empty() ? run_dir + ": no checkpoint (expected " + checkpoint_dir(run_dir) + ")"
+                                              : problems + "; no usable checkpoint in " + run_dir);
+  if (!problems.empty()) std::fprintf(stderr, "comorph: %s; using the previous checkpoint %s\n", problems.c_str(), dir.c_str());
+  const std::string path = (fs::path(dir) / "trainer.yaml").string();
   CheckpointInfo info;
-  info.episodes = n["episodes"].as<int>();
-  info.evaluations = n["evaluations"].as<int>();
-  info.env_steps = n["env_steps"].as<std::int64_t>();
-  info.wall_s = n["wall_s"].as<double>();
-  info.config_text = n["config"].as<std::string>();
+  try {
+    const YAML::Node n = load_yaml_file(path);
+    info.episodes = n["episodes"].as<int>();
+    info.evaluations = n["evaluations"].as<int>();
+    info.env_steps = n["env_steps"].as<std::int64_t>();
+    info.wall_s = n["wall_s"].as<double>();
+    info.config_text = n["config"].as<std::string>();
+    if (n["env_files"]) info.env_text = n["env_files"].as<std::string>();
+    info.has_env_text = static_cast<bool>(n["env_files"]);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(path + ": unreadable checkpoint: " + e.msg);
+  }
   info.directory = dir;
   return info;
+}
+
+void check_checkpoint_counts(const CheckpointInfo& info, const CooptConfig& config) {
+  const int total = config.trainer.warmup_episodes + config.trainer.episodes;
+  if (info.episodes < 0 || info.episodes > total)
+    throw std::runtime_error(info.directory + ": the checkpoint counts " + std::to_string(info.episodes) +
+                             " episodes, the config has " + std::to_string(total) +
+                             " (warm-up + training); refusing to resume");
+  if (info.evaluations < 0 || info.evaluations > info.episodes)
+    throw std::runtime_error(info.directory + ": the checkpoint counts " + std::to_string(info.evaluations) +
+                             " evaluations after " + std::to_string(info.episodes) +
+                             " episodes; refusing to resume");
+  if (info.env_steps < 0 || info.wall_s < 0)
+    throw std::runtime_error(info.directory + ": the checkpoint counts " + std::to_string(info.env_steps) +
+                             " control steps and " + std::to_string(info.wall_s) + " s; refusing to resume");
+}
+
+void check_same_run(const CheckpointInfo& info, const CooptConfig& config, const std::string& run_dir) {
+  if (info.config_text != config.text)
+    throw std::runtime_error(run_dir + ": the checkpoint was written by another configuration (" +
+                             first_difference(config.text, info.config_text) + ")");
+  if (!info.has_env_text)
+    std::fprintf(stderr, "comorph: warning: %s predates simulator-config checks: configs/sim not compared\n",
+                 info.directory.c_str());
+  else if (info.env_text != config.env_text)
+    throw std::runtime_error(run_dir + ": the simulator config (" + config.env_dir +
+                             ") changed since the checkpoint was written (" +
+                             first_difference(config.env_text, info.env_text) + ")");
 }
 
 void truncate_csv_rows(const std::string& path, int rows) {
@@ -480,9 +545,7 @@ void truncate_csv_rows(const std::string& path, int rows) {
     ++kept;
   }
   in.close();
-  const std::string tmp = path + ".tmp";
-  write_text_file(tmp, text);
-  fs::rename(tmp, path);
+  write_text_file(path, text);
 }
 
 struct Trainer::Impl {
@@ -670,6 +733,29 @@ struct Trainer::Impl {
     const std::string tmp = dir + ".tmp", old = dir + ".old";
     fs::remove_all(tmp);
     fs::create_directories(tmp);
+    try {
+      write_checkpoint_files(tmp);
+    } catch (...) {
+      // A full disk: the last good checkpoint stays; free what the partial one took.
+      std::error_code ignored;
+      fs::remove_all(tmp, ignored);
+      try {
+        throw;
+      } catch (const c10::Error& e) {  // any other LibTorch failure: one line, no backtrace
+        const std::string what = e.what_without_backtrace();
+        throw std::runtime_error("cannot write the checkpoint " + tmp + ": " + what.substr(0, what.find('\n')));
+      }
+    }
+    // Swap directories: a crash at any point leaves either `checkpoint` or
+    // `checkpoint.old` complete (read_checkpoint_info falls back to .old).
+    // checkpoint.old stays as the fallback when `checkpoint` is found damaged.
+    fs::remove_all(old);
+    if (fs::exists(dir)) fs::rename(dir, old);
+    fs::rename(tmp, dir);
+  }
+
+  // The files of a checkpoint into `tmp`, the checksums last.
+  void write_checkpoint_files(const std::string& tmp) {
     learner->save((fs::path(tmp) / "motion.pt").string());
     agent.motion->save((fs::path(tmp) / "motion_actor.pt").string());
     if (agent.config) agent.config->save((fs::path(tmp) / "config_model.pt").string());
@@ -680,26 +766,27 @@ struct Trainer::Impl {
     e << YAML::Key << "env_steps" << YAML::Value << steps;
     e << YAML::Key << "wall_s" << YAML::Value << wall();
     e << YAML::Key << "rng" << YAML::Value << rl::rng_state(rng);
+    // env_files ends with a newline, which a literal block keeps; config has
+    // none, which only the last value of the document keeps.
+    e << YAML::Key << "env_files" << YAML::Value << YAML::Literal << config.env_text;
     e << YAML::Key << "config" << YAML::Value << YAML::Literal << config.text;
     e << YAML::EndMap;
     write_text_file((fs::path(tmp) / "trainer.yaml").string(), e.c_str());
-    // Swap directories: a crash at any point leaves either `checkpoint` or
-    // `checkpoint.old` complete (read_checkpoint_info falls back to .old).
-    fs::remove_all(old);
-    if (fs::exists(dir)) fs::rename(dir, old);
-    fs::rename(tmp, dir);
-    fs::remove_all(old);
+    write_checksums(tmp, checkpoint_files(agent.config != nullptr));
   }
 
   void load_checkpoint() {
     const CheckpointInfo info = read_checkpoint_info(run_dir);
-    if (info.config_text != config.text)
-      throw std::runtime_error(run_dir + ": the checkpoint was written by another configuration (" +
-                               first_difference(config.text, info.config_text) + "); refusing to resume");
-    learner->load((fs::path(info.directory) / "motion.pt").string());
-    agent.motion->load((fs::path(info.directory) / "motion_actor.pt").string());
-    if (agent.config) agent.config->load((fs::path(info.directory) / "config_model.pt").string());
-    const YAML::Node n = YAML::LoadFile((fs::path(info.directory) / "trainer.yaml").string());
+    try {
+      check_same_run(info, config, run_dir);
+      check_checkpoint_counts(info, config);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(std::string(e.what()) + "; refusing to resume");
+    }
+    load_checkpoint_file(*learner, (fs::path(info.directory) / "motion.pt").string());
+    load_checkpoint_file(*agent.motion, (fs::path(info.directory) / "motion_actor.pt").string());
+    if (agent.config) load_checkpoint_file(*agent.config, (fs::path(info.directory) / "config_model.pt").string());
+    const YAML::Node n = load_yaml_file((fs::path(info.directory) / "trainer.yaml").string());
     rl::set_rng_state(rng, n["rng"].as<std::string>());
     episode = info.episodes;
     evaluations = info.evaluations;
@@ -755,9 +842,7 @@ namespace {
 // and their results must not depend on how many there are.
 CheckpointInfo open_checkpoint_for_evaluation(const CooptConfig& config, const std::string& run_dir) {
   CheckpointInfo info = read_checkpoint_info(run_dir);
-  if (info.config_text != config.text)
-    throw std::runtime_error(run_dir + ": the checkpoint was written by another configuration (" +
-                             first_difference(config.text, info.config_text) + ")");
+  check_same_run(info, config, run_dir);
   rl::set_torch_threads(1, 1);
   return info;
 }
@@ -773,9 +858,9 @@ struct GreedyPlayer {
 
   GreedyPlayer(const CooptConfig& c, const CheckpointInfo& checkpoint) : config(c), env(c.env), scene(c) {
     agent.motion = make_motion(c, 1, true);
-    agent.motion->load((fs::path(checkpoint.directory) / "motion_actor.pt").string());
+    load_checkpoint_file(*agent.motion, (fs::path(checkpoint.directory) / "motion_actor.pt").string());
     agent.config = make_config_model(c, 2);
-    if (agent.config) agent.config->load((fs::path(checkpoint.directory) / "config_model.pt").string());
+    if (agent.config) load_checkpoint_file(*agent.config, (fs::path(checkpoint.directory) / "config_model.pt").string());
     allocate_buffers(c, buffers);
   }
 
@@ -828,6 +913,9 @@ std::uintmax_t export_policy(const CooptConfig& config, const std::string& run_d
   player.agent.motion->save_policy((out / "motion_actor.pt").string());
   if (player.agent.config) player.agent.config->save_policy((out / "config_model.pt").string());
   fs::copy_file(fs::path(info.directory) / "trainer.yaml", out / "trainer.yaml", fs::copy_options::overwrite_existing);
+  std::vector<std::string> names{"motion_actor.pt", "trainer.yaml"};
+  if (player.agent.config) names.push_back("config_model.pt");
+  write_checksums(out_checkpoint_dir, names);  // verified on load like a training checkpoint's
   std::uintmax_t bytes = 0;
   for (const auto& e : fs::directory_iterator(out)) bytes += fs::file_size(e.path());
   return bytes;

@@ -90,10 +90,21 @@ struct CheckpointInfo {
   std::int64_t env_steps = 0;   // training control steps done
   double wall_s = 0;            // training wall time so far, s
   std::string config_text;      // the merged config the run was started with
+  std::string env_text;         // CooptConfig::env_text of the run (the simulator config files)
+  bool has_env_text = false;    // false: written before env_text was stored (not compared)
   std::string directory;        // where it was read from
 };
-// Reads the latest complete checkpoint of a run (throws when there is none).
+// Reads the latest complete checkpoint of a run whose files match their
+// checksums (common/checksum.hpp): checkpoint/, or checkpoint.old/ (said on
+// stderr) when checkpoint/ is damaged or missing. Throws naming the damaged
+// file when neither is usable, or when there is no checkpoint.
 CheckpointInfo read_checkpoint_info(const std::string& run_dir);
+// Throws (with the numbers) unless 0 <= episodes <= the config's warm-up +
+// training episodes, 0 <= evaluations <= episodes and steps, wall time >= 0.
+void check_checkpoint_counts(const CheckpointInfo& info, const CooptConfig& config);
+// Throws (naming the first differing line) when the checkpoint was written by
+// another merged config or another simulator config (configs/sim/*.yaml).
+void check_same_run(const CheckpointInfo& info, const CooptConfig& config, const std::string& run_dir);
 // Keeps the header and the first `rows` data rows of a CSV file (resume after a kill).
 void truncate_csv_rows(const std::string& path, int rows);
 

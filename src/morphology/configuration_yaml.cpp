@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/yaml_fields.hpp"  // parse_yaml, read_text_file, write_file_atomic
 #include "morphology/configuration.hpp"
 
 namespace comorph {
@@ -45,13 +46,7 @@ void read_matrix(const YAML::Node& node, const std::string& source, const std::s
 }  // namespace
 
 Configuration configuration_from_yaml(const std::string& text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(source + ": not valid YAML: " + e.msg + " (line " +
-                             std::to_string(e.mark.line + 1) + ")");
-  }
+  const YAML::Node root = parse_yaml(text, source);
   if (!root.IsMap()) throw std::runtime_error(source + ": expected a mapping with C_a and C_s");
   for (const auto& item : root) {
     const std::string key = item.first.as<std::string>();
@@ -80,11 +75,7 @@ Configuration configuration_from_yaml(const std::string& text, const std::string
 }
 
 Configuration load_configuration(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open configuration file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return configuration_from_yaml(buffer.str(), path);
+  return configuration_from_yaml(read_text_file(path), path);
 }
 
 std::string to_yaml(const Configuration& config) {
@@ -103,10 +94,7 @@ std::string to_yaml(const Configuration& config) {
 }
 
 void save_configuration(const std::string& path, const Configuration& config) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot write configuration file");
-  out << to_yaml(config);
-  if (!out) throw std::runtime_error(path + ": write failed");
+  write_file_atomic(path, to_yaml(config));
 }
 
 }  // namespace comorph

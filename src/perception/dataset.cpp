@@ -226,7 +226,7 @@ DatasetWriter::DatasetWriter(const std::string& path, int height, int width, int
   if (!file_) fail(path, "cannot create " + tmp_path_ + ": " + std::strerror(errno));
   std::uint8_t header[kHeaderBytes];
   make_header(header, 0, height, width, classes, encoding);  // count patched by finish()
-  if (std::fwrite(header, 1, kHeaderBytes, file_) != kHeaderBytes) fail(path, "write error");
+  if (std::fwrite(header, 1, kHeaderBytes, file_) != kHeaderBytes) fail(path, std::string("write error: ") + std::strerror(errno));
   row_.resize(static_cast<std::size_t>(height) * width * bytes_per_pixel(encoding));
 }
 
@@ -241,7 +241,8 @@ void DatasetWriter::add(const float* depth, int label) {
   if (!file_) fail(path_, "add() after finish()");
   check_label("dataset " + path_, label, classes_);
   encode(depth, static_cast<std::size_t>(height_) * width_, encoding_, row_.data());
-  if (std::fwrite(row_.data(), 1, row_.size(), file_) != row_.size()) fail(path_, "write error");
+  if (std::fwrite(row_.data(), 1, row_.size(), file_) != row_.size())
+    fail(path_, std::string("write error: ") + std::strerror(errno));
   labels_.push_back(static_cast<std::uint8_t>(label));
 }
 
@@ -252,11 +253,13 @@ void DatasetWriter::finish() {
   std::uint8_t count[4];
   put_u32(count, static_cast<std::uint32_t>(labels_.size()));
   ok = ok && std::fseek(file_, 12, SEEK_SET) == 0 && std::fwrite(count, 1, 4, file_) == 4;
+  ok = ok && std::fflush(file_) == 0;
+  const int err = errno;  // of the failed write, before fclose may change it
   ok = (std::fclose(file_) == 0) && ok;
   file_ = nullptr;
   if (!ok) {
     std::remove(tmp_path_.c_str());
-    fail(path_, "write error");
+    fail(path_, std::string("write error: ") + std::strerror(err != 0 ? err : errno));
   }
   if (std::rename(tmp_path_.c_str(), path_.c_str()) != 0) {
     std::remove(tmp_path_.c_str());

@@ -6,8 +6,11 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <stdexcept>
 
+#include "common/torch_archive.hpp"
+#include "common/yaml_fields.hpp"  // load_yaml_file, write_file_atomic
 #include "perception/scene_classifier_impl.hpp"
 
 namespace comorph::perception {
@@ -24,15 +27,10 @@ void check_params(const ClassifierParams& p) {
 }
 
 ClassifierParams read_sidecar(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
+  if (!std::filesystem::is_regular_file(path))
     throw std::runtime_error(path + ": cannot open the classifier sidecar (is the directory a "
                                     "saved classifier?)");
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": not valid YAML: " + e.msg);
-  }
+  const YAML::Node root = load_yaml_file(path);
   auto field = [&](const char* key) {
     if (!root.IsMap() || !root[key]) throw std::runtime_error(path + ": missing field '" + key + "'");
     return root[key];
@@ -69,17 +67,6 @@ void check_expected(const std::string& path, const ClassifierParams& got,
   mismatch("width", got.width, want.width);
 }
 
-// Write `text` to `path` through a temporary file and a rename.
-void write_atomically(const std::filesystem::path& path, const std::string& text) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    if (!out) throw std::runtime_error(tmp.string() + ": write error");
-  }
-  std::filesystem::rename(tmp, path);
-}
-
 torch::Tensor input_tensor(const SceneClassifier::Impl& m, const float* depths, int n, int h, int w) {
   if (n < 1) throw std::invalid_argument("SceneClassifier: need at least one image");
   if (h != m.params.image_size || w != m.params.image_size)
@@ -94,11 +81,16 @@ torch::Tensor input_tensor(const SceneClassifier::Impl& m, const float* depths, 
 }  // namespace
 
 torch::Device parse_device(const std::string& device) {
+  std::optional<torch::Device> d;
   try {
-    return torch::Device(device);
+    d.emplace(device);
   } catch (const c10::Error&) {
-    throw std::invalid_argument("unknown torch device '" + device + "' (cpu, cuda, cuda:N)");
+    throw std::invalid_argument("unknown torch device '" + quote_value(device) + "' (cpu, cuda, cuda:N)");
   }
+  // Here, not at the first forward pass deep inside LibTorch.
+  if (d->is_cuda() && (!torch::cuda::is_available() || (d->has_index() && static_cast<std::size_t>(d->index()) >= torch::cuda::device_count())))
+    throw std::invalid_argument("torch device '" + device + "' is not available here (use cpu)");
+  return *d;
 }
 
 SceneClassifier::SceneClassifier(const ClassifierParams& params, std::uint64_t seed) {
@@ -177,11 +169,9 @@ void SceneClassifier::save(const std::string& dir) const {
   fs::create_directories(dir);
   const fs::path weights = fs::path(dir) / kWeightsFile;
   const fs::path tmp = weights.string() + ".tmp";
-  try {
-    torch::save(m.net, tmp.string());
-  } catch (const c10::Error& e) {
-    throw std::runtime_error(tmp.string() + ": cannot save the weights: " + e.what_without_backtrace());
-  }
+  torch::serialize::OutputArchive archive;
+  m.net->save(archive);  // what torch::save(m.net, ...) writes, through a checked writer
+  save_archive(archive, tmp.string());
   fs::rename(tmp, weights);
 
   YAML::Emitter y;
@@ -196,7 +186,7 @@ void SceneClassifier::save(const std::string& dir) const {
   y << YAML::Key << "width" << YAML::Value << m.params.width;
   y << YAML::Key << "input" << YAML::Value << "depth, 1 x image_size x image_size, in [0.01, 1]";
   y << YAML::EndMap;
-  write_atomically(fs::path(dir) / kSidecarFile, std::string(y.c_str()) + "\n");
+  write_file_atomic((fs::path(dir) / kSidecarFile).string(), std::string(y.c_str()) + "\n");
 }
 
 SceneClassifier SceneClassifier::load(const std::string& dir, const ClassifierParams* expected,

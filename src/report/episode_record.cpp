@@ -5,10 +5,13 @@
 #include <map>
 #include <optional>
 #include <ostream>
+#include <sstream>
 #include <stdexcept>
 #include <string_view>
 
 #include <fmt/format.h>
+
+#include "common/file_io.hpp"
 
 namespace comorph::report {
 namespace {
@@ -96,10 +99,9 @@ void write_episodes_csv(std::ostream& out, const std::vector<EpisodeRecord>& rec
 }
 
 void write_episodes_csv(const std::string& path, const std::vector<EpisodeRecord>& records) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(fmt::format("cannot write {}", path));
+  std::ostringstream out;
   write_episodes_csv(out, records);
-  if (!out) throw std::runtime_error(fmt::format("error writing {}", path));
+  write_file_atomic(path, out.str());
 }
 
 std::vector<EpisodeRecord> read_episodes_csv(std::istream& in, const std::string& source) {

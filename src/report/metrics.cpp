@@ -8,6 +8,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "common/file_io.hpp"
+
 namespace comorph::report {
 namespace {
 
@@ -115,10 +117,7 @@ Metrics metrics_from_json(const nlohmann::json& j, const std::string& where) {
 }
 
 void write_metrics_json(const std::string& path, const Metrics& metrics) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(fmt::format("cannot write {}", path));
-  out << to_json(metrics).dump(2) << "\n";
-  if (!out) throw std::runtime_error(fmt::format("error writing {}", path));
+  write_file_atomic(path, to_json(metrics).dump(2) + "\n");
 }
 
 Metrics read_metrics_json(const std::string& path) {

@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "common/yaml_fields.hpp"  // load_yaml_file
+
 namespace comorph::report {
 namespace {
 
@@ -31,14 +33,7 @@ double get_or_nan(const YAML::Node& node, const std::string& key, const std::str
 std::string default_paper_reference_path() { return COMORPH_PAPER_REFERENCE; }
 
 PaperReference load_paper_reference(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw std::runtime_error(fmt::format("cannot open the paper reference {}", path));
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(fmt::format("{}: invalid YAML: {}", path, e.what()));
-  }
+  const YAML::Node root = load_yaml_file(path);  // size cap, duplicate keys
   PaperReference ref;
   ref.source = get<std::string>(root, "source", path);
   if (root["protocol"]) ref.protocol = get<std::string>(root, "protocol", path);

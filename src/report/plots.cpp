@@ -1,10 +1,12 @@
 #include "report/plots.hpp"
 
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
+#include "common/file_io.hpp"
 #include "report/process.hpp"
 
 namespace comorph::report {
@@ -62,12 +64,11 @@ void plot_training_curves(const std::vector<CurveSeries>& series, const std::str
     const auto score_avg = moving_average(score, options.window);
     const auto success_avg = moving_average(success, options.window);
     const std::string data_path = fmt::format("{}-{}.dat", base, i);
-    std::ofstream data(data_path);
-    if (!data) throw std::runtime_error(fmt::format("cannot write {}", data_path));
+    std::ostringstream data;
     data << "# episode  score(R1)  score_moving_avg  success_rate_percent(window " << options.window << ")\n";
     for (size_t k = 0; k < score.size(); ++k)
       data << fmt::format("{} {} {} {}\n", s.episodes[k].episode, score[k], score_avg[k], success_avg[k]);
-    if (!data) throw std::runtime_error(fmt::format("error writing {}", data_path));
+    write_file_atomic(data_path, data.str());
 
     // Per-episode scores faint (alpha 0xB0 of 0xFF transparent), averages bold.
     const std::string c = colour(i);
@@ -80,8 +81,7 @@ void plot_training_curves(const std::vector<CurveSeries>& series, const std::str
   }
 
   const std::string script_path = base + ".gp";
-  std::ofstream script(script_path);
-  if (!script) throw std::runtime_error(fmt::format("cannot write {}", script_path));
+  std::ostringstream script;
   script << "# Written by comorph report; run `gnuplot " << script_path << "` to redraw.\n"
          << fmt::format("set terminal {} size {},{}\n", options.terminal, options.width_px, options.height_px)
          << "set output " << quoted(png_path) << "\n"
@@ -96,8 +96,7 @@ void plot_training_curves(const std::vector<CurveSeries>& series, const std::str
          << fmt::format("set title 'Success rate over the last {} episodes'\n", options.window)
          << "plot " << success_plot << "\n"
          << "unset multiplot\nunset output\n";
-  script.close();
-  if (!script) throw std::runtime_error(fmt::format("error writing {}", script_path));
+  write_file_atomic(script_path, script.str());
   run_tool({gnuplot, script_path});
   std::ifstream png(png_path, std::ios::binary | std::ios::ate);
   if (!png || png.tellg() <= 0) throw std::runtime_error(fmt::format("gnuplot wrote no image to {}", png_path));

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "common/file_io.hpp"
 #include "report/plots.hpp"
 #include "report/process.hpp"
 
@@ -311,12 +312,8 @@ ReportResult write_report(const std::vector<std::string>& run_dirs, const Report
 
   result.markdown_path = (out / "report.md").string();
   result.html_path = (out / "report.html").string();
-  std::ofstream md(result.markdown_path);
-  md << render_markdown(doc);
-  if (!md) throw std::runtime_error(fmt::format("cannot write {}", result.markdown_path));
-  std::ofstream html(result.html_path);
-  html << render_html(doc, "comorph report");
-  if (!html) throw std::runtime_error(fmt::format("cannot write {}", result.html_path));
+  write_file_atomic(result.markdown_path, render_markdown(doc));
+  write_file_atomic(result.html_path, render_html(doc, "comorph report"));
   spdlog::info("report: {} and {} ({} images)", result.markdown_path, result.html_path, result.images.size());
   return result;
 }

@@ -8,19 +8,14 @@
 
 #include <fmt/format.h>
 
+#include "common/yaml_fields.hpp"  // load_yaml_file, write_file_atomic
+
 namespace fs = std::filesystem;
 
 namespace comorph::report {
 
 RunInfo read_run_info(const std::string& path, const std::string& default_name) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw std::runtime_error(fmt::format("cannot open {}", path));
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(fmt::format("{}: invalid YAML: {}", path, e.what()));
-  }
+  const YAML::Node root = load_yaml_file(path);  // size cap, duplicate keys
   if (!root.IsMap()) throw std::runtime_error(fmt::format("{}: expected a map of fields", path));
   auto text = [&](const char* key, bool required, const std::string& fallback) {
     if (!root[key]) {
@@ -67,9 +62,7 @@ void write_run_info(const std::string& path, const RunInfo& info) {
   if (!info.preset.empty()) out << YAML::Key << "preset" << YAML::Value << info.preset;
   if (!info.notes.empty()) out << YAML::Key << "notes" << YAML::Value << info.notes;
   out << YAML::EndMap;
-  std::ofstream file(path);
-  if (!file) throw std::runtime_error(fmt::format("cannot write {}", path));
-  file << out.c_str() << "\n";
+  write_file_atomic(path, std::string(out.c_str()) + "\n");
 }
 
 RunDir load_run_dir(const std::string& path) {

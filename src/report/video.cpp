@@ -2,7 +2,10 @@
 
 #include <spdlog/spdlog.h>
 
+#include <unistd.h>
+
 #include <cstring>
+#include <filesystem>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -21,10 +24,28 @@ void check_image(const Image& image, const char* what) {
                                             image.width, image.height, image.rgb.size()));
 }
 
+// <dir>/<stem>.tmp-<pid><ext>: beside the target, with its extension (ffmpeg
+// picks the container from it).
+std::string temp_beside(const std::string& path) {
+  const std::filesystem::path p(path);
+  return (p.parent_path() / (p.stem().string() + ".tmp-" + std::to_string(::getpid()) + p.extension().string()))
+      .string();
+}
+
+// Renames ffmpeg's finished output into place (removed when that fails).
+void move_into_place(const std::string& tmp, const std::string& path) {
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error(fmt::format("cannot write {}: {}", path, ec.message()));
+  }
+}
+
 }  // namespace
 
 VideoWriter::VideoWriter(const std::string& path, int width, int height, const VideoOptions& options)
-    : path_(path), width_(width), height_(height) {
+    : path_(path), tmp_path_(temp_beside(path)), width_(width), height_(height) {
   if (width < 2 || height < 2) throw std::invalid_argument(fmt::format("video size {} x {} px too small", width, height));
   if (options.fps <= 0) throw std::invalid_argument(fmt::format("video fps {} must be > 0", options.fps));
   std::vector<std::string> argv = {ffmpeg_path(), "-nostdin", "-y", "-loglevel", "error",
@@ -39,7 +60,7 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height, const V
   } else {
     argv.insert(argv.end(), {"-q:v", "4"});
   }
-  argv.insert(argv.end(), {"-movflags", "+faststart", path});
+  argv.insert(argv.end(), {"-movflags", "+faststart", tmp_path_});
   ffmpeg_ = std::make_unique<ChildInput>(argv);
 }
 
@@ -65,8 +86,15 @@ void VideoWriter::add_frame(const Image& frame) {
 void VideoWriter::finish() {
   if (!ffmpeg_) return;
   auto child = std::move(ffmpeg_);
-  child->finish();
-  if (frames_ == 0) throw std::runtime_error(fmt::format("video {}: no frames were written", path_));
+  try {
+    child->finish();
+    if (frames_ == 0) throw std::runtime_error(fmt::format("video {}: no frames were written", path_));
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp_path_, ignored);
+    throw;
+  }
+  move_into_place(tmp_path_, path_);
 }
 
 Image hstack(const std::vector<Image>& images) {
@@ -96,10 +124,18 @@ void write_png(const Image& image, const std::string& path, int height_px) {
                                    "-s", fmt::format("{}x{}", image.width, image.height),
                                    "-i", "pipe:0"};
   if (height_px > 0) argv.insert(argv.end(), {"-vf", fmt::format("scale=-2:{}", height_px)});
-  argv.insert(argv.end(), {"-frames:v", "1", "-update", "1", "-f", "image2", "-c:v", "png", path});
-  ChildInput ffmpeg(argv);
-  ffmpeg.write(image.rgb.data(), image.rgb.size());
-  ffmpeg.finish();
+  const std::string tmp = temp_beside(path);
+  argv.insert(argv.end(), {"-frames:v", "1", "-update", "1", "-f", "image2", "-c:v", "png", tmp});
+  try {
+    ChildInput ffmpeg(argv);
+    ffmpeg.write(image.rgb.data(), image.rgb.size());
+    ffmpeg.finish();
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw;
+  }
+  move_into_place(tmp, path);
 }
 
 }  // namespace comorph::report

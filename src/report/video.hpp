@@ -19,7 +19,9 @@ struct VideoOptions {
 
 class ChildInput;
 
-// Writes frames of one size to an .mp4 through ffmpeg.
+// Writes frames of one size to an .mp4 through ffmpeg, into a temporary file
+// beside `path` that finish() renames to `path` once ffmpeg succeeded (a
+// failed or interrupted video never looks complete).
 class VideoWriter {
  public:
   VideoWriter(const std::string& path, int width, int height, const VideoOptions& options = {});
@@ -32,7 +34,7 @@ class VideoWriter {
   int frames() const { return frames_; }
 
  private:
-  std::string path_;
+  std::string path_, tmp_path_;
   int width_, height_;
   int frames_ = 0;
   std::unique_ptr<ChildInput> ffmpeg_;
@@ -41,7 +43,8 @@ class VideoWriter {
 // The images side by side, left to right, on one row (all the same height).
 Image hstack(const std::vector<Image>& images);
 
-// Writes one image as PNG through ffmpeg; `height_px` > 0 scales it to that height.
+// Writes one image as PNG through ffmpeg (temporary file + rename); `height_px`
+// > 0 scales it to that height.
 void write_png(const Image& image, const std::string& path, int height_px = 0);
 
 }  // namespace comorph::report

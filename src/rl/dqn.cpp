@@ -9,15 +9,16 @@ DqnConfig DqnConfig::from_yaml(const YAML::Node& node, const std::string& source
   DqnConfig c;
   YamlFields f(source);
   add_shared_learner_fields(f, c);
-  f.add("learning_rate", &c.learning_rate);
-  f.add("adam_epsilon", &c.adam_epsilon);
-  f.add("target_update_interval", &c.target_update_interval);
-  f.add("epsilon_start", &c.epsilon_start);
-  f.add("epsilon_end", &c.epsilon_end);
-  f.add("epsilon_decay", &c.epsilon_decay);
+  f.add("learning_rate", &c.learning_rate, kMinPositive, 1.0);
+  f.add("adam_epsilon", &c.adam_epsilon, 1e-20, 1.0);
+  f.add("target_update_interval", &c.target_update_interval, 1, 1000000000);
+  f.add("epsilon_start", &c.epsilon_start, 0.0, 1.0);
+  f.add("epsilon_end", &c.epsilon_end, 0.0, 1.0);
+  f.add("epsilon_decay", &c.epsilon_decay, 0.0, 1e12);
   f.add("loss", &c.loss);
   f.add("double_dqn", &c.double_dqn);
   f.apply(node);
+  check_hidden_sizes(f, c);
   if (c.loss != "huber" && c.loss != "mse")
     throw std::invalid_argument(source + ": field \"loss\" must be huber or mse, got \"" + c.loss + "\"");
   if (c.batch_size <= 0 || c.buffer_size <= 0 || c.train_frequency <= 0 ||
@@ -145,7 +146,7 @@ void Dqn::save(const std::string& path) const {
   a.write("q_target", target);
   a.write("optimizer", opt);
   a.write("replay", replay);
-  a.save_to(path);
+  save_archive(a, path);
 }
 
 void Dqn::save_policy(const std::string& path) const {
@@ -154,7 +155,7 @@ void Dqn::save_policy(const std::string& path) const {
   mark_policy_only(a);
   q_->save(nets);
   a.write("q", nets);
-  a.save_to(path);
+  save_archive(a, path);
 }
 
 void Dqn::load(const std::string& path) {

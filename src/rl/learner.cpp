@@ -4,6 +4,7 @@
 
 #include <dlfcn.h>
 
+#include <optional>
 #include <sstream>
 
 namespace comorph::rl {
@@ -11,11 +12,22 @@ namespace comorph::rl {
 std::string rl_config_dir() { return std::string(COMORPH_SOURCE_DIR) + "/configs/rl"; }
 
 void check_device_name(const std::string& name) {
+  std::optional<torch::Device> device;
   try {
-    torch::Device device(name);
-    (void)device;
+    device.emplace(name);
   } catch (const std::exception&) {
-    throw std::invalid_argument("unknown torch device \"" + name + "\" (use cpu, cuda, cuda:N)");
+    throw std::invalid_argument("unknown torch device \"" + quote_value(name) + "\" (use cpu, cuda, cuda:N)");
+  }
+  if (device->is_cuda()) {
+    if (!torch::cuda::is_available())
+      throw std::invalid_argument("torch device \"" + name + "\" is not available: this LibTorch or machine has "
+                                  "no CUDA device (use cpu)");
+    const auto count = static_cast<int>(torch::cuda::device_count());
+    if (device->has_index() && device->index() >= count)
+      throw std::invalid_argument("torch device \"" + name + "\" is not available: " + std::to_string(count) +
+                                  " CUDA device(s) here");
+  } else if (!device->is_cpu()) {
+    throw std::invalid_argument("torch device \"" + name + "\" is not supported (use cpu, cuda, cuda:N)");
   }
 }
 

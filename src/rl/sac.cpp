@@ -10,20 +10,19 @@ SacConfig SacConfig::from_yaml(const YAML::Node& node, const std::string& source
   SacConfig c;
   YamlFields f(source);
   add_shared_learner_fields(f, c);
-  f.add("actor_learning_rate", &c.actor_learning_rate);
-  f.add("critic_learning_rate", &c.critic_learning_rate);
-  f.add("alpha_learning_rate", &c.alpha_learning_rate);
-  f.add("random_action_steps", &c.random_action_steps);
-  f.add("random_action_episodes", &c.random_action_episodes);
-  f.add("policy_frequency", &c.policy_frequency);
-  f.add("target_network_frequency", &c.target_network_frequency);
-  f.add("alpha", &c.alpha);
+  add_actor_critic_fields(f, c);
+  f.add("alpha_learning_rate", &c.alpha_learning_rate, kMinPositive, 1.0);
+  f.add("policy_frequency", &c.policy_frequency, 1, 1000000);
+  f.add("target_network_frequency", &c.target_network_frequency, 1, 1000000);
+  f.add("alpha", &c.alpha, kMinPositive, 1000.0);
   f.add("autotune_alpha", &c.autotune_alpha);
-  f.add("target_entropy_scale", &c.target_entropy_scale);
-  f.add("log_std_min", &c.log_std_min);
-  f.add("log_std_max", &c.log_std_max);
+  f.add("target_entropy_scale", &c.target_entropy_scale, -100.0, 100.0);
+  f.add("log_std_min", &c.log_std_min, -20.0, 10.0);
+  f.add("log_std_max", &c.log_std_max, -20.0, 10.0);
   f.add("share_encoder", &c.share_encoder);
   f.apply(node);
+  check_hidden_sizes(f, c);
+  if (!(c.log_std_min < c.log_std_max)) f.fail("log_std_max", "must be above log_std_min");
   if (c.batch_size <= 0 || c.buffer_size <= 0 || c.train_frequency <= 0 ||
       c.policy_frequency <= 0 || c.target_network_frequency <= 0)
     throw std::invalid_argument(source + ": batch_size, buffer_size, train_frequency, "
@@ -200,7 +199,7 @@ void Sac::save(const std::string& path) const {
   a.write("critic_optimizer", critic_opt);
   a.write("alpha_optimizer", alpha_opt);
   a.write("replay", replay);
-  a.save_to(path);
+  save_archive(a, path);
 }
 
 void Sac::save_policy(const std::string& path) const {
@@ -209,7 +208,7 @@ void Sac::save_policy(const std::string& path) const {
   mark_policy_only(a);
   nets_->save(nets);
   a.write("networks", nets);
-  a.save_to(path);
+  save_archive(a, path);
 }
 
 void Sac::load(const std::string& path) {

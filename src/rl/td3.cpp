@@ -10,21 +10,19 @@ Td3Config Td3Config::from_yaml(const YAML::Node& node, const std::string& source
   Td3Config c;
   YamlFields f(source);
   add_shared_learner_fields(f, c);
-  f.add("actor_learning_rate", &c.actor_learning_rate);
-  f.add("critic_learning_rate", &c.critic_learning_rate);
-  f.add("random_action_steps", &c.random_action_steps);
-  f.add("random_action_episodes", &c.random_action_episodes);
-  f.add("policy_delay", &c.policy_delay);
-  f.add("policy_noise", &c.policy_noise);
-  f.add("noise_clip", &c.noise_clip);
-  f.add("exploration_noise_start", &c.exploration_noise_start);
-  f.add("exploration_noise_end", &c.exploration_noise_end);
-  f.add("exploration_noise_decay", &c.exploration_noise_decay);
+  add_actor_critic_fields(f, c);
+  f.add("policy_delay", &c.policy_delay, 1, 1000000);
+  f.add("policy_noise", &c.policy_noise, 0.0, 10.0);
+  f.add("noise_clip", &c.noise_clip, 0.0, 10.0);
+  f.add("exploration_noise_start", &c.exploration_noise_start, 0.0, 10.0);
+  f.add("exploration_noise_end", &c.exploration_noise_end, 0.0, 10.0);
+  f.add("exploration_noise_decay", &c.exploration_noise_decay, 0.0, 1e12);
   f.add("exploration_noise_unit", &c.exploration_noise_unit);
   f.add("share_encoder", &c.share_encoder);
   f.add("bc_weight", &c.bc_weight, 0.0, 1000.0);
   f.add("bc_decay_updates", &c.bc_decay_updates, std::int64_t(0), std::int64_t(1) << 40);
   f.apply(node);
+  check_hidden_sizes(f, c);
   if (c.exploration_noise_unit != "transitions" && c.exploration_noise_unit != "episodes")
     throw std::invalid_argument(source + ": field \"exploration_noise_unit\" must be transitions "
                                          "or episodes, got \"" + c.exploration_noise_unit + "\"");
@@ -188,7 +186,7 @@ void Td3::save(const std::string& path) const {
   a.write("actor_optimizer", actor_opt);
   a.write("critic_optimizer", critic_opt);
   a.write("replay", replay);
-  a.save_to(path);
+  save_archive(a, path);
 }
 
 void Td3::save_policy(const std::string& path) const {
@@ -197,7 +195,7 @@ void Td3::save_policy(const std::string& path) const {
   mark_policy_only(a);
   nets_->save(nets);
   a.write("networks", nets);
-  a.save_to(path);
+  save_archive(a, path);
 }
 
 void Td3::load(const std::string& path) {

@@ -1,6 +1,7 @@
 #include "task/env_config.hpp"
 
 #include <filesystem>
+#include <stdexcept>
 
 #include "common/yaml_fields.hpp"
 
@@ -32,8 +33,36 @@ TaskParams task_params_from_yaml(const std::string& text, const std::string& sou
   return p;
 }
 
+namespace {
+const char* const kEnvFiles[] = {"robot.yaml", "scene.yaml", "motion.yaml", "task.yaml"};
+
+void require_directory(const std::string& dir) {
+  namespace fs = std::filesystem;
+  if (!fs::exists(dir)) throw std::runtime_error(dir + ": no such config directory (robot/scene/motion/task.yaml)");
+  if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": not a directory (expected robot/scene/motion/task.yaml)");
+}
+}  // namespace
+
+std::string env_files_text(const std::string& dir) {
+  namespace fs = std::filesystem;
+  require_directory(dir);
+  std::string text;
+  for (const char* name : kEnvFiles) {
+    const std::string path = (fs::path(dir) / name).string();
+    if (!fs::exists(path)) {
+      text += std::string("# ") + name + ": absent (built-in defaults)\n";
+      continue;
+    }
+    YAML::Emitter e;
+    e << load_yaml_file(path);
+    text += std::string("# ") + name + "\n" + e.c_str() + "\n";
+  }
+  return text;
+}
+
 EnvConfig load_env_config(const std::string& dir) {
   namespace fs = std::filesystem;
+  require_directory(dir);
   EnvConfig c;
   auto path = [&](const char* name) { return (fs::path(dir) / name).string(); };
   if (fs::exists(path("robot.yaml"))) c.robot = sim::load_robot_params(path("robot.yaml"));

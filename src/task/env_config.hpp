@@ -28,8 +28,14 @@ struct EnvConfig {
 };
 
 // Loads <dir>/robot.yaml, scene.yaml, motion.yaml and task.yaml (each optional:
-// a missing file keeps the defaults). Errors name the file and the field.
+// a missing file keeps the defaults). Errors name the file and the field; a
+// `dir` that is not a directory is an error (not the built-in defaults).
 EnvConfig load_env_config(const std::string& dir);
+// What of <dir> a run depends on, as text: per file its name and its YAML
+// parsed and emitted again (comments and layout do not count, values do; an
+// absent file says so). Part of a run's identity: a resume compares it, so an
+// edited robot.yaml cannot change a run's physics halfway.
+std::string env_files_text(const std::string& dir);
 TaskParams task_params_from_yaml(const std::string& text, const std::string& source_name,
                                  TaskParams defaults = {});
 

@@ -234,6 +234,14 @@ TEST(Classifier, RejectsDataThatDoesNotFit) {
   cp::ClassifierParams bad = small_net();
   bad.device = "toaster";
   EXPECT_THROW(cp::SceneClassifier{bad}, std::invalid_argument);
+  // A CUDA device this machine does not have: refused when the classifier is made.
+  bad.device = "cuda:7";
+  try {
+    cp::SceneClassifier c{bad};
+    ADD_FAILURE() << "made a classifier on cuda:7";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("torch device 'cuda:7' is not available here"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(TrainedClassifier, SwitchTrialsDetectTheChangesWithinTwoIntervals) {

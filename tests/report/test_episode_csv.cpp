@@ -25,6 +25,7 @@ std::vector<EpisodeRecord> sample() {
     r.return_R1 = -12.5 + 0.1 * i;
     r.configurations = i == 3 ? std::vector<int>{} : std::vector<int>{4 + i, 2};
     r.modules_total = 4 + i;
+    r.action_saturation = i / 9.0;
     out.push_back(r);
   }
   return out;
@@ -36,7 +37,7 @@ TEST(EpisodeCsv, RoundTripIsExact) {
   const std::string text = s.str();
   EXPECT_EQ(text.substr(0, text.find('\n')),
             "episode,seed,scenario,stair_height_m,obstacles,success,termination,time_s,energy_J,"
-            "distance_fraction,return_R1,configurations,modules_total");
+            "distance_fraction,return_R1,configurations,modules_total,action_saturation");
   EXPECT_NE(text.find(",4;2,"), std::string::npos) << text;
   const auto back = read_episodes_csv(s, "mem");
   const auto orig = sample();
@@ -55,7 +56,20 @@ TEST(EpisodeCsv, RoundTripIsExact) {
     EXPECT_EQ(back[i].return_R1, orig[i].return_R1);
     EXPECT_EQ(back[i].configurations, orig[i].configurations);
     EXPECT_EQ(back[i].modules_total, orig[i].modules_total);
+    EXPECT_EQ(back[i].action_saturation, orig[i].action_saturation);
   }
+}
+
+// Logs written before the action_saturation column existed still read (as 0).
+TEST(EpisodeCsv, ALogWithoutTheSaturationColumnReadsAsZero) {
+  std::stringstream s(
+      "episode,seed,scenario,stair_height_m,obstacles,success,termination,time_s,energy_J,"
+      "distance_fraction,return_R1,configurations,modules_total\n"
+      "0,7,default,0.04,6,1,success,30,2900,0.95,800,4;2,4\n");
+  const auto back = read_episodes_csv(s, "mem");
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_EQ(back[0].modules_total, 4);
+  EXPECT_EQ(back[0].action_saturation, 0.0);
 }
 
 std::string error_of(const std::string& csv) {

@@ -2,6 +2,7 @@
 // image differs from the same scene without it), the tracking camera keeps it
 // in view, and the video and the keyframe strip come out of ffmpeg.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <mujoco/mujoco.h>
 
@@ -153,6 +154,45 @@ TEST(Render, EpisodeVideoAndKeyframeStrip) {
                                       "default=nw=1", opt.strip_path});
   EXPECT_NE(strip.find("width=320"), std::string::npos) << strip;  // 4 frames of 80 px side by side
   EXPECT_NE(strip.find("height=60"), std::string::npos) << strip;
+}
+
+// A video appears under its name only once ffmpeg has finished it; one that
+// ffmpeg cannot finish (an unknown encoder here; a full disk alike) leaves
+// neither the file nor its temporary behind.
+TEST(Render, AVideoLooksCompleteOnlyWhenItIs) {
+  const fs::path dir = fs::temp_directory_path() / ("comorph_render_fail_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  {
+    VideoWriter video((dir / "ok.mp4").string(), 16, 16);
+    Image frame;
+    frame.width = frame.height = 16;
+    frame.rgb.assign(16 * 16 * 3, 100);
+    for (int i = 0; i < 40; ++i) video.add_frame(frame);
+    EXPECT_FALSE(fs::exists(dir / "ok.mp4"));  // ffmpeg writes a temporary file meanwhile
+    video.finish();
+  }
+  EXPECT_TRUE(fs::is_regular_file(dir / "ok.mp4"));
+  fs::remove(dir / "ok.mp4");
+  EXPECT_TRUE(fs::is_empty(dir));
+  VideoOptions bad;
+  bad.codec = "no_such_encoder";
+  EXPECT_THROW(
+      {
+        VideoWriter video((dir / "x.mp4").string(), 16, 16, bad);
+        Image frame;
+        frame.width = frame.height = 16;
+        frame.rgb.assign(16 * 16 * 3, 100);
+        try {
+          video.add_frame(frame);
+        } catch (const std::exception&) {
+          // ffmpeg may have exited already; finish() reports it
+        }
+        video.finish();
+      },
+      std::runtime_error);
+  EXPECT_TRUE(fs::is_empty(dir));
+  fs::remove_all(dir);
 }
 
 TEST(Render, KeyframesAreEvenlySpaced) {

@@ -5,19 +5,11 @@
 #include <fstream>
 
 #include "sim/params.hpp"
+#include "support/test_support.hpp"
 
 using namespace comorph::sim;
 
-namespace {
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
-}
-}  // namespace
+using comorph::test_support::error_of;
 
 TEST(Params, RepositoryConfigsLoadAndMatchTheDefaults) {
   const std::string dir = std::string(COMORPH_SOURCE_DIR) + "/configs/sim/";
