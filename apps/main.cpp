@@ -30,7 +30,8 @@ int main(int argc, char** argv) {
     // `comorph export-mjcf > /dev/full` must not exit 0.
     comorph::flush_stdout();
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version are "errors" with code 0; every real parse error is status 2.
+    return app.exit(e) == 0 ? 0 : 2;
   } catch (const std::exception& e) {
     std::cerr << "comorph: error: " << e.what() << "\n";
     return 1;

@@ -272,6 +272,14 @@ report::Metrics eval_run(const std::string& run_dir, const std::string& scenario
     std::printf("%-8s %-9s %s\n", (key + " m").c_str(), format_rate(m.success_rate.at(key)).c_str(), seqs.c_str());
   }
   std::printf("%-8s %-9s\n", "avg", format_rate(m.success_rate.at("avg")).c_str());
+  std::string first;
+  for (const std::string& key : comorph::report::paper_stair_keys())
+    if (m.first_modules.count(key) && !std::isnan(m.first_modules.at(key)))
+      first += fmt::format("{}{:.2f} at {} m", first.empty() ? "" : ", ", m.first_modules.at(key), key);
+  if (!first.empty())
+    std::printf("first configuration, mean modules: %s; after the stairs shed to 2-3 modules: %s of the episodes "
+                "that climbed them\n",
+                first.c_str(), std::isnan(m.shed_after_stairs) ? "-" : fmt::format("{:.0f} %", 100 * m.shed_after_stairs).c_str());
   std::printf("time %s s, energy %s J (means over successful episodes), F %.3f\n",
               std::isnan(m.time_s) ? "-" : fmt::format("{:.1f}", m.time_s).c_str(),
               std::isnan(m.energy_J) ? "-" : fmt::format("{:.0f}", m.energy_J).c_str(), m.F);

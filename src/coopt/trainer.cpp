@@ -316,6 +316,7 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
   log.return_R2 = return_r2;
   log.steps = m.steps;
   log.stairs_energy_J = env.stairs_energy();
+  log.stairs_climbed = env.stairs_climbed();
   log.action_saturation =
       m.steps > 0 ? static_cast<double>(saturated) / (static_cast<double>(m.steps) * control::kActionSize) : 0.0;
   return log;

@@ -81,7 +81,7 @@ void check_text(const std::string& text, const char* name) {
 const std::vector<std::string>& episode_csv_columns() {
   static const std::vector<std::string> columns = {
       "episode", "seed", "scenario", "stair_height_m", "obstacles", "success", "termination", "time_s",
-      "energy_J", "distance_fraction", "return_R1", "configurations", "modules_total", "action_saturation"};
+      "energy_J", "distance_fraction", "return_R1", "configurations", "modules_total", "action_saturation", "stairs_climbed"};
   return columns;
 }
 
@@ -91,10 +91,10 @@ void write_episodes_csv(std::ostream& out, const std::vector<EpisodeRecord>& rec
     check_text(r.scenario, "scenario");
     check_text(r.termination, "termination");
     // fmt's "{}" for a double is the shortest text that reads back exactly.
-    out << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", r.episode, r.seed, r.scenario,
+    out << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", r.episode, r.seed, r.scenario,
                        r.stair_height_m, r.obstacles, r.success ? 1 : 0, r.termination, r.time_s, r.energy_J,
                        r.distance_fraction, r.return_R1, fmt::join(r.configurations, ";"), r.modules_total,
-                       r.action_saturation);
+                       r.action_saturation, r.stairs_climbed ? 1 : 0);
   }
 }
 
@@ -125,8 +125,8 @@ std::vector<EpisodeRecord> read_episodes_csv(std::istream& in, const std::string
   std::vector<size_t> at;
   for (const auto& name : episode_csv_columns()) {
     auto it = index.find(name);
-    // Logs written before the saturation column existed read as 0.
-    if (it == index.end() && name == "action_saturation") {
+    // Logs written before these columns existed read as 0.
+    if (it == index.end() && (name == "action_saturation" || name == "stairs_climbed")) {
       at.push_back(header.size());
       continue;
     }
@@ -163,6 +163,7 @@ std::vector<EpisodeRecord> read_episodes_csv(std::istream& in, const std::string
       r.configurations = parse_configurations(f(11));
       r.modules_total = parse_number<int>(f(12), "modules_total");
       if (at[13] < fields.size()) r.action_saturation = parse_number<double>(f(13), "action_saturation");
+      if (at[14] < fields.size()) r.stairs_climbed = parse_number<int>(f(14), "stairs_climbed") != 0;
       records.push_back(std::move(r));
     } catch (const FieldError& e) {
       throw fail(e.column, e.what());

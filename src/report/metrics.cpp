@@ -48,7 +48,9 @@ Metrics summarize(const std::vector<EpisodeRecord>& records, const task::Objecti
   std::map<std::string, std::pair<int, int>> per_height;  // key -> (successes, episodes)
   for (const auto& k : paper_stair_keys()) per_height[k] = {0, 0};
   double time_sum = 0, energy_sum = 0, F_sum = 0;
-  int successes = 0;
+  int successes = 0, climbed = 0, shed = 0;
+  std::map<std::string, std::pair<double, int>> first;  // key -> (sum of first modules, episodes with a choice)
+  for (const auto& k : paper_stair_keys()) first[k] = {0.0, 0};
   for (const auto& r : records) {
     const std::string key = stair_key(r.stair_height_m);
     auto& [wins, count] = per_height[key];
@@ -62,7 +64,17 @@ Metrics summarize(const std::vector<EpisodeRecord>& records, const task::Objecti
     F_sum += objective_F(r, weights);
     ++m.configurations[key][configuration_sequence(r.configurations)];
     ++m.terminations[r.termination];
+    if (!r.configurations.empty()) {
+      first[key].first += r.configurations.front();
+      ++first[key].second;
+    }
+    if (r.stairs_climbed && !r.configurations.empty()) {
+      ++climbed;
+      shed += r.configurations.back() <= 3;
+    }
   }
+  for (const auto& [key, sc] : first) m.first_modules[key] = sc.second > 0 ? sc.first / sc.second : kNaN;
+  m.shed_after_stairs = climbed > 0 ? static_cast<double>(shed) / climbed : kNaN;
   double rate_sum = 0;
   int heights = 0;
   for (const auto& [key, wc] : per_height) {
@@ -91,6 +103,9 @@ nlohmann::json to_json(const Metrics& m) {
   for (const auto& [height, counts] : m.configurations) j["configurations"][height] = counts;
   j["terminations"] = m.terminations;
   j["episodes"] = m.episodes;
+  j["first_modules"] = nlohmann::json::object();
+  for (const auto& [k, v] : m.first_modules) j["first_modules"][k] = number_or_null(v);
+  j["shed_after_stairs"] = number_or_null(m.shed_after_stairs);
   return j;
 }
 
@@ -110,6 +125,12 @@ Metrics metrics_from_json(const nlohmann::json& j, const std::string& where) {
     m.configurations = need(j, "configurations", where).get<std::map<std::string, std::map<std::string, int>>>();
     m.terminations = need(j, "terminations", where).get<std::map<std::string, int>>();
     m.episodes = need(j, "episodes", where).get<int>();
+    m.shed_after_stairs = kNaN;
+    if (j.contains("first_modules") && j["first_modules"].is_object())
+      for (auto it = j["first_modules"].begin(); it != j["first_modules"].end(); ++it)
+        m.first_modules[it.key()] = read_number_or_null(it.value(), "first_modules." + it.key(), where);
+    if (j.contains("shed_after_stairs"))
+      m.shed_after_stairs = read_number_or_null(j["shed_after_stairs"], "shed_after_stairs", where);
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(fmt::format("{}: configurations, terminations or episodes malformed: {}", where, e.what()));
   }

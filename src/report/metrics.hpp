@@ -38,12 +38,19 @@ struct Metrics {
   // Per stair-height key: configuration sequence ("4->2") -> episodes.
   std::map<std::string, std::map<std::string, int>> configurations;
   std::map<std::string, int> terminations;  // termination reason -> episodes
+  // The configuration model's choice: per stair-height key, the mean modules of
+  // the first configuration (NaN when no episode had that height); and the
+  // share of the episodes that climbed the stairs whose last configuration has
+  // 2 or 3 modules (shed after the stairs; NaN when none climbed them).
+  std::map<std::string, double> first_modules;
+  double shed_after_stairs = 0;
 };
 
 Metrics summarize(const std::vector<EpisodeRecord>& records, const task::ObjectiveWeights& weights = {});
 
 // JSON with exactly the keys success_rate, time_s, energy_J, F, configurations,
-// terminations, episodes; NaN is written as null.
+// terminations, episodes, first_modules, shed_after_stairs; NaN is written as
+// null. Reading accepts JSON without the last two (written before they existed).
 nlohmann::json to_json(const Metrics& metrics);
 // Reads that JSON back (other keys are ignored); throws naming `source` and
 // the key when a key is missing or has the wrong type.

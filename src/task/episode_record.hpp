@@ -23,6 +23,7 @@ struct EpisodeRecord {
   double return_R1 = 0;            // sum of the motion reward R1 (Eq. 6) over the episode
   std::vector<int> configurations; // modules of each configuration chosen, in order (e.g. 4 then 2)
   int modules_total = 0;           // modules (batteries) on board at the start of the episode
+  bool stairs_climbed = false;     // every module reached the top of the stairs (the flat area)
   double action_saturation = 0;    // share of executed motion-action components at the bound (|a| >= 0.99), 0..1
 };
 

@@ -144,7 +144,7 @@ TEST(Numbers, BadNumbersOnTheCommandLineAreErrorsNamingTheOption) {
   // Checked while the command line is parsed: no run is needed to see it.
   const std::string run = "/nonexistent/run";
   for (const std::string bad : {"--episodes -3", "--workers -1", "--seed -5", "--episodes nan"}) {
-    EXPECT_NE(run_cli("eval --run " + run + " " + bad, log), 0) << bad;
+    EXPECT_EQ(exit_code(run_cli("eval --run " + run + " " + bad, log)), 2) << bad;  // a command-line error
     EXPECT_NE(log.find(bad.substr(0, bad.find(' '))), std::string::npos) << bad << ": " << log;
     EXPECT_NE(log.find("expected a whole number"), std::string::npos) << bad << ": " << log;
   }

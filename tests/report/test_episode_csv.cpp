@@ -26,6 +26,7 @@ std::vector<EpisodeRecord> sample() {
     r.configurations = i == 3 ? std::vector<int>{} : std::vector<int>{4 + i, 2};
     r.modules_total = 4 + i;
     r.action_saturation = i / 9.0;
+    r.stairs_climbed = i % 3 == 1;
     out.push_back(r);
   }
   return out;
@@ -37,7 +38,7 @@ TEST(EpisodeCsv, RoundTripIsExact) {
   const std::string text = s.str();
   EXPECT_EQ(text.substr(0, text.find('\n')),
             "episode,seed,scenario,stair_height_m,obstacles,success,termination,time_s,energy_J,"
-            "distance_fraction,return_R1,configurations,modules_total,action_saturation");
+            "distance_fraction,return_R1,configurations,modules_total,action_saturation,stairs_climbed");
   EXPECT_NE(text.find(",4;2,"), std::string::npos) << text;
   const auto back = read_episodes_csv(s, "mem");
   const auto orig = sample();
@@ -57,6 +58,7 @@ TEST(EpisodeCsv, RoundTripIsExact) {
     EXPECT_EQ(back[i].configurations, orig[i].configurations);
     EXPECT_EQ(back[i].modules_total, orig[i].modules_total);
     EXPECT_EQ(back[i].action_saturation, orig[i].action_saturation);
+    EXPECT_EQ(back[i].stairs_climbed, orig[i].stairs_climbed);
   }
 }
 
@@ -70,6 +72,7 @@ TEST(EpisodeCsv, ALogWithoutTheSaturationColumnReadsAsZero) {
   ASSERT_EQ(back.size(), 1u);
   EXPECT_EQ(back[0].modules_total, 4);
   EXPECT_EQ(back[0].action_saturation, 0.0);
+  EXPECT_FALSE(back[0].stairs_climbed);
 }
 
 std::string error_of(const std::string& csv) {

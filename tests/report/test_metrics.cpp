@@ -113,14 +113,33 @@ TEST(Metrics, HeightsWithoutEpisodesAreLeftOutOfTheMean) {
   EXPECT_TRUE(to_json(m)["success_rate"]["0.08"].is_null());
 }
 
+// The configuration figures: mean first choice per height, and the share of
+// the episodes that reached the flat area that ended on 2 or 3 modules.
+TEST(Metrics, FirstChoicePerHeightAndSheddingAfterTheStairs) {
+  std::vector<EpisodeRecord> log = hand_log();
+  log[0].stairs_climbed = true;  // 2 -> 2: ends on 2
+  log[2].stairs_climbed = true;  // 4 -> 2: shed
+  log[3].configurations = {4, 4};
+  log[3].stairs_climbed = true;  // kept 4
+  const Metrics m = summarize(log);
+  EXPECT_DOUBLE_EQ(m.first_modules.at("0.04"), 2.0);
+  EXPECT_DOUBLE_EQ(m.first_modules.at("0.06"), 4.0);
+  EXPECT_DOUBLE_EQ(m.first_modules.at("0.08"), 6.0);
+  EXPECT_DOUBLE_EQ(m.shed_after_stairs, 2.0 / 3.0);
+  const Metrics back = metrics_from_json(nlohmann::json::parse(to_json(m).dump()), "test");
+  EXPECT_EQ(back.first_modules, m.first_modules);
+  EXPECT_DOUBLE_EQ(back.shed_after_stairs, m.shed_after_stairs);
+  EXPECT_TRUE(std::isnan(summarize({hand_log()[1]}).shed_after_stairs));  // nobody climbed
+}
+
 TEST(Metrics, JsonHasExactlyTheAgreedKeysAndReadsBack) {
   const Metrics m = summarize(hand_log());
   const nlohmann::json j = to_json(m);
   std::vector<std::string> keys;
   for (auto it = j.begin(); it != j.end(); ++it) keys.push_back(it.key());
   std::sort(keys.begin(), keys.end());
-  EXPECT_EQ(keys, (std::vector<std::string>{"F", "configurations", "energy_J", "episodes", "success_rate",
-                                            "terminations", "time_s"}));
+  EXPECT_EQ(keys, (std::vector<std::string>{"F", "configurations", "energy_J", "episodes", "first_modules",
+                                            "shed_after_stairs", "success_rate", "terminations", "time_s"}));
   for (const char* k : {"0.04", "0.06", "0.08", "avg"}) EXPECT_TRUE(j["success_rate"].contains(k)) << k;
   EXPECT_EQ(j["configurations"]["0.06"]["4->2"], 2);
 
