@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The main job of `make run`: train the scene classifier (ResNet-18 on labelled
 # simulator depth images, ~2 minutes) into runs/classifier, train the quick
-# preset (configs/quick.yaml, 15 to 20 minutes on 2 cores) into runs/quick with
+# preset (configs/quick.yaml, about 12 minutes on 2 cores) into runs/quick with
 # that classifier driving the scene-switch detector, evaluate it greedily on the
 # paper's protocol (stair heights 0.04/0.06/0.08 m), render one evaluation
 # episode per stair height to video, write the report (tables beside the
@@ -14,20 +14,9 @@ comorph="$build_dir/apps/comorph"
 run=runs/quick
 classifier=runs/classifier
 
-if [ ! -f "$classifier/classifier.pt" ]; then
-  "$comorph" classifier prepare --out "$classifier"
-fi
-
-if [ -f "$run/checkpoint/trainer.yaml" ] || [ -f "$run/checkpoint.old/trainer.yaml" ]; then
-  "$comorph" train --resume "$run"
-else
-  if [ -e "$run" ]; then
-    echo "$run exists without a checkpoint; move it away first" >&2
-    exit 1
-  fi
-  "$comorph" train --config configs/quick.yaml --out "$run" \
-    --set trainer.scene_source=classifier --set trainer.classifier_dir="$classifier"
-fi
+source scripts/run-lib.sh
+prepare_classifier "$comorph" "$classifier"
+train_or_resume "$comorph" "$run" configs/quick.yaml "$classifier"
 "$comorph" eval --run "$run" --scenario default
 # Evaluation episodes 0, 1, 2 = stair heights 0.04, 0.06, 0.08 m (~20 s each).
 for seed in 700000 700001 700002; do

@@ -150,24 +150,14 @@ void Dqn::save(const std::string& path) const {
 }
 
 void Dqn::save_policy(const std::string& path) const {
-  torch::serialize::OutputArchive a, nets;
-  write_common(a, counters_, rng_, "dqn");
-  mark_policy_only(a);
-  q_->save(nets);
-  a.write("q", nets);
-  save_archive(a, path);
+  save_policy_file(path, *q_, "q", counters_, rng_, "dqn");
 }
 
 void Dqn::load(const std::string& path) {
   torch::serialize::InputArchive a, nets, target, opt, replay;
   a.load_from(path, device_);
   read_common(a, counters_, rng_, "dqn");
-  if (is_policy_only(a)) {
-    torch::serialize::InputArchive policy;
-    a.read("q", policy);
-    q_->load(policy);
-    return;
-  }
+  if (read_policy_only(a, "q", *q_)) return;
   a.read("q", nets);
   a.read("q_target", target);
   a.read("optimizer", opt);

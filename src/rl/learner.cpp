@@ -72,11 +72,23 @@ void write_common(torch::serialize::OutputArchive& a, const LearnerCounters& c,
   a.write("rng", c10::IValue(rng_state(rng)));
 }
 
-void mark_policy_only(torch::serialize::OutputArchive& a) { a.write("policy_only", c10::IValue(true)); }
+void save_policy_file(const std::string& path, const torch::nn::Module& networks, const std::string& key,
+                      const LearnerCounters& counters, const std::mt19937_64& rng, const std::string& algorithm) {
+  torch::serialize::OutputArchive a, nets;
+  write_common(a, counters, rng, algorithm);
+  a.write("policy_only", c10::IValue(true));
+  networks.save(nets);
+  a.write(key, nets);
+  save_archive(a, path);
+}
 
-bool is_policy_only(torch::serialize::InputArchive& a) {
+bool read_policy_only(torch::serialize::InputArchive& a, const std::string& key, torch::nn::Module& networks) {
   c10::IValue flag;
-  return a.try_read("policy_only", flag) && flag.toBool();
+  if (!a.try_read("policy_only", flag) || !flag.toBool()) return false;
+  torch::serialize::InputArchive nets;
+  a.read(key, nets);
+  networks.load(nets);
+  return true;
 }
 
 void read_common(torch::serialize::InputArchive& a, LearnerCounters& c, std::mt19937_64& rng,

@@ -24,6 +24,9 @@
 #include "common/yaml_fields.hpp"  // YamlFields, load_yaml_file: every from_yaml
 #include "rl/env.hpp"
 
+namespace torch::nn {
+class Module;
+}  // namespace torch::nn
 namespace torch::serialize {
 class OutputArchive;
 class InputArchive;
@@ -140,8 +143,11 @@ void write_common(torch::serialize::OutputArchive& archive, const LearnerCounter
                   const std::mt19937_64& rng, const std::string& algorithm);
 void read_common(torch::serialize::InputArchive& archive, LearnerCounters& counters,
                  std::mt19937_64& rng, const std::string& algorithm);
-// Marks an archive as policy-only (save_policy) / tells whether it is one.
-void mark_policy_only(torch::serialize::OutputArchive& archive);
-bool is_policy_only(torch::serialize::InputArchive& archive);
+// save_policy's file: the common header, a policy-only mark and `networks`
+// under `key`. read_policy_only loads `networks` from such an archive and
+// returns true, or returns false (and reads nothing) for a full checkpoint.
+void save_policy_file(const std::string& path, const torch::nn::Module& networks, const std::string& key,
+                      const LearnerCounters& counters, const std::mt19937_64& rng, const std::string& algorithm);
+bool read_policy_only(torch::serialize::InputArchive& archive, const std::string& key, torch::nn::Module& networks);
 
 }  // namespace comorph::rl

@@ -190,24 +190,14 @@ void Td3::save(const std::string& path) const {
 }
 
 void Td3::save_policy(const std::string& path) const {
-  torch::serialize::OutputArchive a, nets;
-  write_common(a, counters_, rng_, "td3");
-  mark_policy_only(a);
-  nets_->save(nets);
-  a.write("networks", nets);
-  save_archive(a, path);
+  save_policy_file(path, *nets_, "networks", counters_, rng_, "td3");
 }
 
 void Td3::load(const std::string& path) {
   torch::serialize::InputArchive a, nets, target, actor_opt, critic_opt, replay;
   a.load_from(path, device_);
   read_common(a, counters_, rng_, "td3");
-  if (is_policy_only(a)) {
-    torch::serialize::InputArchive policy;
-    a.read("networks", policy);
-    nets_->load(policy);
-    return;
-  }
+  if (read_policy_only(a, "networks", *nets_)) return;
   a.read("networks", nets);
   a.read("target_networks", target);
   a.read("actor_optimizer", actor_opt);
