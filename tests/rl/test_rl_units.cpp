@@ -474,25 +474,19 @@ void expect_policy_round_trip(const C& config, int actions, const std::string& n
 }
 
 TEST(Learners, APolicyOnlyFileActsLikeTheLearnerThatSavedIt) {
-  rl::Td3Config td3;
-  td3.hidden_sizes = {16};
-  td3.learning_starts = 0;
-  td3.random_action_steps = 0;
-  td3.buffer_size = 2000;
-  td3.batch_size = 16;
-  rl::SacConfig sac;
-  sac.hidden_sizes = {16};
-  sac.learning_starts = 0;
-  sac.random_action_steps = 0;
-  sac.buffer_size = 2000;
-  sac.batch_size = 16;
-  rl::DqnConfig dqn;
-  dqn.hidden_sizes = {16};
-  dqn.buffer_size = 2000;
-  dqn.batch_size = 16;
+  auto small = [](auto c) {
+    c.hidden_sizes = {16};
+    c.learning_starts = 0;
+    c.buffer_size = 2000;
+    c.batch_size = 16;
+    return c;
+  };
+  rl::Td3Config td3 = small(rl::Td3Config{});
+  rl::SacConfig sac = small(rl::SacConfig{});
+  td3.random_action_steps = sac.random_action_steps = 0;
   expect_policy_round_trip<rl::Td3>(td3, 1, "td3");
   expect_policy_round_trip<rl::Sac>(sac, 1, "sac");
-  expect_policy_round_trip<rl::Dqn>(dqn, 4, "dqn");
+  expect_policy_round_trip<rl::Dqn>(small(rl::DqnConfig{}), 4, "dqn");
 }
 
 // ---- hyperparameter files -----------------------------------------------------------
