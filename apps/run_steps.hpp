@@ -33,8 +33,8 @@ report::Metrics eval_run(const std::string& run_dir, const std::string& scenario
                          int workers);
 
 // Copies what `eval`, `render` and `report` need of a trained run into `out`
-// (config.yaml, run.yaml, episodes.csv, evaluations.csv, eval-*.json and their
-// episode CSVs) with a checkpoint/ of the acting networks only (no replay, no
+// (config.yaml, run.yaml, episodes.csv rounded to the report's digits,
+// evaluations.csv, eval-*.json) with a checkpoint/ of the acting networks only (no replay, no
 // optimizers): a trained policy small enough to ship in the repository. The
 // copy evaluates like the run; it cannot resume training. Returns its bytes.
 std::uintmax_t export_run(const std::string& run_dir, const std::string& out);
