@@ -286,6 +286,14 @@ void World::render_depth(float* out) const {
   cast_depth(rays_, pos, module_mat(0), out);
 }
 
+int World::depth_rows_above_horizon() const {
+  const int w = robot_.depth_width;
+  int rows = 0;
+  for (int i = 0; i < robot_.depth_height; ++i)
+    if (rays_.dirs[3 * (std::size_t(i) * w + w / 2) + 2] > 0) rows = i + 1;  // z of the level carrier frame
+  return std::max(rows, 1);
+}
+
 void World::render_decision_depth(float* out) const {
   double pos[3];
   camera_pos(pos);

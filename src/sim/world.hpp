@@ -51,6 +51,9 @@ class World {
   // Depth image from module 1's camera, row-major depth_height x depth_width,
   // planar depth / depth_max_range clipped to [0.01, 1] (1 = nothing in range).
   void render_depth(float* out) const;
+  // Rows of the depth image (from the top) whose centre ray looks above the
+  // horizon when the camera's carrier stands level (at least 1).
+  int depth_rows_above_horizon() const;
   // The decision camera (RobotParams::decision_*) at module 1's camera position:
   // decision_depth_height x decision_depth_width, same depth encoding.
   void render_decision_depth(float* out) const;

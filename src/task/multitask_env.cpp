@@ -26,13 +26,7 @@ MultiTaskEnv::MultiTaskEnv(const EnvConfig& config, std::shared_ptr<sim::ModelCa
   const sim::RobotParams& r = config_.robot;
   depth_.assign(std::size_t(r.depth_width) * r.depth_height, 1.0f);
   clearance_.assign(std::size_t(r.depth_width), 1.0f);
-  // Row i's centre looks atan(v_i) - pitch above the horizon (World's pinhole grid).
-  horizon_rows_ = 0;
-  for (int i = 0; i < r.depth_height; ++i) {
-    const double v = (1.0 - 2.0 * (i + 0.5) / r.depth_height) * std::tan(0.5 * r.depth_fov_y);
-    if (std::atan(v) > r.depth_pitch) horizon_rows_ = i + 1;
-  }
-  horizon_rows_ = std::max(horizon_rows_, 1);
+  horizon_rows_ = world_.depth_rows_above_horizon();
 }
 
 void MultiTaskEnv::reset(const EpisodeSpec& spec) {
