@@ -55,6 +55,13 @@ struct TrainerParams {
   std::string warmup_policy = "random";
   double warmup_noise = 0.2;          // std of the noise on the pilot's actions (action units)
   int scripted_interval = 0;          // after the warm-up, every this-many-th episode is the pilot's too (0 = none)
+  // Those later pilot episodes choose their configurations uniformly, as the
+  // warm-up does, instead of asking the DQN: the motion model keeps seeing
+  // demonstrations with every chain length, and the DQN the outcome of each.
+  bool pilot_random_configs = false;
+  // The pilot climbs with each chain length's own searched gait
+  // (task::searched_stair_gaits); false: one gait (a0, a2, a3, a4) = (1, 1, -0.5, 1) for all.
+  bool pilot_gait_per_modules = false;
   // Every training transition carries the pilot's action for its state as a
   // behaviour-cloning target (td3.bc_weight), also where the motion model drove:
   // the pilot labels the states the learner visits (DAgger, Ross et al. 2011).

@@ -45,7 +45,8 @@ rl::ObservationSpec motion_spec(const CooptConfig& c) {
     s.image_height = c.env.robot.depth_height;
     s.image_width = c.env.robot.depth_width;
   }
-  s.vector_size = task::obs::kStateSize + (c.trainer.motion_clearance ? c.env.robot.depth_width : 0);
+  s.vector_size =
+      task::obs::kStateSize + (c.trainer.motion_clearance ? task::MultiTaskEnv::clearance_width(c.env.robot) : 0);
   return s;
 }
 
@@ -183,7 +184,7 @@ void fill_motion(const task::MultiTaskEnv& env, const TrainerParams& t, rl::Obse
     o.vector[static_cast<std::size_t>(i)] = v;
   }
   if (t.motion_clearance)
-    std::copy(env.clearance(), env.clearance() + env.depth_width(), o.vector.begin() + task::obs::kStateSize);
+    std::copy(env.clearance(), env.clearance() + env.clearance_width(), o.vector.begin() + task::obs::kStateSize);
 }
 
 void fill_config(const task::MultiTaskEnv& env, const TrainerParams& t, int max_modules, int scene, Buffers& b,
@@ -593,7 +594,10 @@ struct Trainer::Impl {
     }
     worker = std::make_unique<LearnerWorker>(c.trainer.learner_thread);
     scene.label_source = callbacks.label_source;
-    pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};  // the gait the physics-table search picks
+    if (c.trainer.pilot_gait_per_modules)
+      pilot.params() = task::searched_stair_gaits();
+    else
+      pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};  // the gait the physics-table search picks
   }
 
   double wall() const { return wall_before + std::chrono::duration<double>(Clock::now() - started).count(); }
@@ -663,7 +667,9 @@ struct Trainer::Impl {
         callbacks.on_decision(d);
       }
     };
-    if (warmup)
+    const bool scripted = t.warmup_policy == "scripted" &&
+                          (warmup || (t.scripted_interval > 0 && episode % t.scripted_interval == 0));
+    if (warmup || (scripted && t.pilot_random_configs))
       hooks.random_config = [this](const std::vector<std::uint8_t>& mask) {
         int valid = 0;
         for (auto m : mask) valid += m;
@@ -672,8 +678,6 @@ struct Trainer::Impl {
           if (mask[a] && k-- == 0) return a;
         return -1;
       };
-    const bool scripted = t.warmup_policy == "scripted" &&
-                          (warmup || (t.scripted_interval > 0 && episode % t.scripted_interval == 0));
     if (scripted || t.pilot_labels) {
       hooks.pilot = &pilot;
       hooks.pilot_drives = scripted;

@@ -55,6 +55,15 @@ struct RobotParams {
   double decision_fov_y = 0.45;       // rad, vertical field of view
   double decision_fov_x = 0.9;        // rad, horizontal field of view
   double decision_pitch = 0.03;       // rad, looks down by this much
+  // Obstacle scan: a level fan of rays from the camera position, every control
+  // step (a ring of range sensors, or a planar lidar). With scan_columns > 0 it
+  // is the clearance row the motion model reads (task::MultiTaskEnv::clearance);
+  // 0 = the clearance row comes from the depth image's rows above the horizon.
+  // Why wider than the camera: an obstacle the robot turns away from leaves a
+  // 1.2 rad view while it is still in the way, and a model without memory then
+  // turns back into it.
+  int scan_columns = 0;               // rays, uniform in angle, column 0 at the left
+  double scan_fov_x = 3.0;            // rad, the fan's total angle, centred on module 1's heading
   double distance_range = 1.0;    // m, left/right distance sensors saturate at 1.0 here
   double distance_height = 0.08;  // m above ground
   // ---- energy ----

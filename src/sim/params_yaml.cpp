@@ -43,6 +43,8 @@ RobotParams robot_params_from_yaml(const std::string& text, const std::string& s
   f.add("decision_fov_y", &p.decision_fov_y, 0.05, 3.0);
   f.add("decision_fov_x", &p.decision_fov_x, 0.05, 3.0);
   f.add("decision_pitch", &p.decision_pitch, -1.5, 1.5);
+  f.add("scan_columns", &p.scan_columns, 0, 256);
+  f.add("scan_fov_x", &p.scan_fov_x, 0.05, 6.28);
   f.add("camera_height", &p.camera_height, 0.0, 1.0);
   f.add("distance_range", &p.distance_range, 0.05, 20);
   f.add("distance_height", &p.distance_height, 0.0, 1.0);

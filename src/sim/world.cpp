@@ -30,6 +30,20 @@ World::World(const RobotParams& robot, const SceneParams& scene, std::shared_ptr
                     robot_.depth_pitch);
   decision_rays_ = make_rays(robot_.decision_depth_width, robot_.decision_depth_height, robot_.decision_fov_x,
                              robot_.decision_fov_y, robot_.decision_pitch);
+  if (robot_.scan_columns > 0) scan_rays_ = make_fan(robot_.scan_columns, robot_.scan_fov_x);
+}
+
+World::RaySet World::make_fan(int columns, double fov_x) {
+  RaySet r;
+  r.dirs.resize(std::size_t(3) * columns);
+  r.forward_dot.assign(std::size_t(columns), 1.0);  // radial distance
+  for (int j = 0; j < columns; ++j) {
+    const double yaw = 0.5 * fov_x - fov_x * (j + 0.5) / columns;  // + left
+    r.dirs[3 * std::size_t(j)] = std::cos(yaw);
+    r.dirs[3 * std::size_t(j) + 1] = std::sin(yaw);
+    r.dirs[3 * std::size_t(j) + 2] = 0.0;
+  }
+  return r;
 }
 
 World::RaySet World::make_rays(int w, int h, double fov_x, double fov_y, double p) {
@@ -298,6 +312,13 @@ void World::render_decision_depth(float* out) const {
   double pos[3];
   camera_pos(pos);
   cast_depth(decision_rays_, pos, module_mat(0), out);
+}
+
+void World::render_scan(float* out) const {
+  if (scan_rays_.forward_dot.empty()) throw std::logic_error("World::render_scan: RobotParams::scan_columns is 0");
+  double pos[3];
+  camera_pos(pos);
+  cast_depth(scan_rays_, pos, module_mat(0), out);
 }
 
 int World::render_view_from(double x, double y, double yaw, float* out) const {

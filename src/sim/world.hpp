@@ -57,6 +57,10 @@ class World {
   // The decision camera (RobotParams::decision_*) at module 1's camera position:
   // decision_depth_height x decision_depth_width, same depth encoding.
   void render_decision_depth(float* out) const;
+  // The obstacle scan (RobotParams::scan_*): scan_columns distances along level
+  // rays from module 1's camera position, column 0 at the left, distance /
+  // depth_max_range clipped to [0.01, 1] (radial, not planar). Needs scan_columns > 0.
+  void render_scan(float* out) const;
   // The same camera placed at an arbitrary pose: the camera's position (m, scene
   // frame) and the heading (yaw, rad) and pitch-up (rad) of the module carrying it.
   void render_depth_at(const double pos[3], double yaw, double pitch, float* out) const;
@@ -108,6 +112,7 @@ class World {
     std::vector<double> forward_dot;  // dir . optical axis, for planar depth
   };
   static RaySet make_rays(int width, int height, double fov_x, double fov_y, double pitch);
+  static RaySet make_fan(int columns, double fov_x);  // level rays, uniform in angle, radial range
   void cast_depth(const RaySet& rays, const double pos[3], const double R[9], float* out) const;
   void camera_pos(double pos[3]) const;
 
@@ -127,6 +132,7 @@ class World {
   double shed_energy_ = 0;  // J drawn by modules that were shed
   RaySet rays_;           // the motion camera (depth_*)
   RaySet decision_rays_;  // the decision camera (decision_*)
+  RaySet scan_rays_;      // the obstacle scan (scan_*), empty when scan_columns = 0
 };
 
 const char* instability_name(Instability i);

@@ -25,7 +25,7 @@ MultiTaskEnv::MultiTaskEnv(const EnvConfig& config, std::shared_ptr<sim::ModelCa
     : config_(config), world_(config.robot, config.scene, std::move(cache)) {
   const sim::RobotParams& r = config_.robot;
   depth_.assign(std::size_t(r.depth_width) * r.depth_height, 1.0f);
-  clearance_.assign(std::size_t(r.depth_width), 1.0f);
+  clearance_.assign(std::size_t(clearance_width(r)), 1.0f);
   horizon_rows_ = world_.depth_rows_above_horizon();
 }
 
@@ -176,11 +176,15 @@ void MultiTaskEnv::reconfigure(int modules) {
 void MultiTaskEnv::update_observation() {
   const int n = world_.modules();
   world_.render_depth(depth_.data());
-  const int w = depth_width();
-  for (int j = 0; j < w; ++j) {
-    float nearest = 1.0f;
-    for (int i = 0; i < horizon_rows_; ++i) nearest = std::min(nearest, depth_[std::size_t(i) * w + j]);
-    clearance_[std::size_t(j)] = nearest;
+  if (config_.robot.scan_columns > 0) {
+    world_.render_scan(clearance_.data());
+  } else {
+    const int w = depth_width();
+    for (int j = 0; j < w; ++j) {
+      float nearest = 1.0f;
+      for (int i = 0; i < horizon_rows_; ++i) nearest = std::min(nearest, depth_[std::size_t(i) * w + j]);
+      clearance_[std::size_t(j)] = nearest;
+    }
   }
   world_.read_distances(distances_.data());
   const double* head = world_.module_pos(0);

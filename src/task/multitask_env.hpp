@@ -105,7 +105,11 @@ class MultiTaskEnv {
   // rows that look above the horizon (they never see the floor a robot stands
   // on, so only obstacles, risers, the target post or 1 = nothing within range).
   // depth_width() floats in [0.01, 1], column 0 at the left.
+  // With RobotParams::scan_columns > 0 it is the obstacle scan instead (a level
+  // fan of range rays, World::render_scan): clearance_width() floats.
   const float* clearance() const { return clearance_.data(); }
+  int clearance_width() const { return clearance_width(config_.robot); }
+  static int clearance_width(const sim::RobotParams& r) { return r.scan_columns > 0 ? r.scan_columns : r.depth_width; }
   // The decision camera's image (decision_depth_height() x decision_depth_width()),
   // rendered on request: the configuration model reads it only when it decides.
   void render_decision_depth(float* out) const { world_.render_decision_depth(out); }

@@ -257,3 +257,33 @@ TEST(Env, ClearanceSeesWhatRisesAboveTheCameraStraightAhead) {
   for (int i = 0; i < c.robot.depth_height; ++i) nearest = std::min(nearest, env.depth()[i * w + w / 2]);
   EXPECT_LT(nearest, 0.1f);
 }
+
+// With scan_columns > 0 the clearance row is the obstacle scan: level rays,
+// uniform in angle, radial distance. Riser 2 of 0.08 m steps stands 0.9 m ahead
+// across the stairs' 2 m width, so the ray at yaw phi meets it at 0.9 / cos(phi)
+// up to |phi| = 0.84 rad: also at +-0.69 rad, outside the depth camera's +-0.6.
+TEST(Env, ObstacleScanSeesRisersOutsideTheCameraView) {
+  task::EnvConfig c;
+  c.robot.scan_columns = 24;
+  c.robot.scan_fov_x = 3.0;
+  task::MultiTaskEnv env(c);
+  ASSERT_EQ(env.clearance_width(), 24);
+  env.reset(spec(3, 4, 0.08, 0));
+  int checked = 0;
+  for (int j = 0; j < 24; ++j) {
+    const double yaw = 1.5 - 3.0 * (j + 0.5) / 24;
+    if (std::abs(yaw) > 0.75) continue;
+    EXPECT_NEAR(env.clearance()[j] * c.robot.depth_max_range, 0.9 / std::cos(yaw), 0.08 / std::cos(yaw))
+        << "column " << j << ", yaw " << yaw;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 12);
+  // 0.04 m steps: risers 1 and 2 (tops 0.04, 0.08 m) are below the camera, the
+  // level rays pass over them to riser 3 (top 0.12 m), 1.3 m ahead.
+  env.reset(spec(3, 4, 0.04, 0));
+  for (int j = 7; j < 17; ++j) {  // |yaw| < 0.6: riser 3 is 1 m wide on each side
+    const double yaw = 1.5 - 3.0 * (j + 0.5) / 24;
+    EXPECT_NEAR(env.clearance()[j] * c.robot.depth_max_range, 1.3 / std::cos(yaw), 0.08 / std::cos(yaw))
+        << "column " << j;
+  }
+}

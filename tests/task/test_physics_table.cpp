@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "task/physics_table.hpp"
+#include "task/scripted_pilot.hpp"
 
 using namespace comorph;
 
@@ -42,4 +43,18 @@ TEST(PhysicsTable, TurningGetsHarderWithLength) {
   EXPECT_GT(two, 0.0);  // a1 > 0 turns left
   EXPECT_GT(two, 2 * six);
   EXPECT_GT(six, ten);
+}
+
+// One gait does not suit every length: the lag that climbs with 2, 4 and 6
+// modules stalls 3 modules on the first riser; the per-length table's gait
+// gets them up (task::searched_stair_gaits).
+TEST(PhysicsTable, ThreeModulesNeedTheirOwnGait) {
+  const task::EnvConfig c;
+  const task::PhysicsTableOptions o;
+  const task::PilotParams p = task::searched_stair_gaits();
+  ASSERT_TRUE(p.use_gait_by_modules[3]);
+  for (std::uint64_t seed : {1, 2}) {
+    EXPECT_FALSE(task::run_climb_trial(c, 3, 0.04, seed, kWave, o).climbed) << seed;
+    EXPECT_TRUE(task::run_climb_trial(c, 3, 0.04, seed, p.gait_by_modules[3], o).climbed) << seed;
+  }
 }
