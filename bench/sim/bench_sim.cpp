@@ -2,7 +2,7 @@
 // depth image, distance sensors, termination, reward) for 2, 6 and 10 modules,
 // in steps per second and as a ratio to the raw mj_step cost of the same
 // physics (16 x mj_step on a copy of the same model and state).
-// Goal (issue 2): >= 1000 control steps/s for 6 modules, overhead <= 25 %.
+// Goal (docs/sim.md): >= 1000 control steps/s for 6 modules, overhead <= 25 %.
 #include <fmt/format.h>
 
 #include <time.h>

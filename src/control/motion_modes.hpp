@@ -1,7 +1,7 @@
 // Motion modes: the 5-D action in [-1, 1] -> wheel speeds and hinge targets
 // (paper Eq. 4 and 5). Pure arithmetic, no MuJoCo state.
 //
-// Chosen reading of the paper (DESIGN.md "Motion modes"):
+// Chosen reading of the paper (docs/sim.md, the motion modes):
 //   a0 -> V_straight = a0 * v_straight_max                     (m/s)
 //   a1 -> V_turning  = a1 * v_turn_max                         (m/s, + turns left)
 //   Eq. 4, every module:  v_left  = w1 * V_straight - w2 * V_turning

@@ -1,4 +1,4 @@
-// Scene-switch detector (paper Sec. II-B; DESIGN.md "The hierarchy"): every
+// Scene-switch detector (paper Sec. II-B; docs/perception.md): every
 // `interval` control steps, look at the labels of the last `window` frames and
 // declare a switch when MORE than `agreement` of them agree on a class other
 // than the current scene. Pure C++, no torch, no allocation per step.

@@ -1,4 +1,4 @@
-// The command line under faults (issue 11), as a user meets them: a full disk
+// The command line under faults (docs/faults.md), as a user meets them: a full disk
 // (/dev/full, a file-size limit), a second writer of a run directory, a run
 // directory whose CSV files do not fit its checkpoint, bad numbers on the
 // command line, missing config directories, directories given as files and

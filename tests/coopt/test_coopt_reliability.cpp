@@ -1,4 +1,4 @@
-// What the trainer refuses instead of using (issue 11): damaged checkpoints
+// What the trainer refuses instead of using (docs/faults.md): damaged checkpoints
 // (checksums, with the fallback to checkpoint.old), torch load errors as one
 // line, counts that do not fit the config, a changed simulator config, a
 // checkpoint write that fails (the last good checkpoint stays), and the
