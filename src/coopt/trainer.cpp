@@ -4,6 +4,7 @@
 #include <torch/torch.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -34,6 +35,30 @@ namespace {
 
 constexpr int kConfigVector = 4;  // C_n / 10, scene one-hot (stairs, obstacles, target)
 using Clock = std::chrono::steady_clock;
+
+// Where the acting thread's time goes (TrainerTiming): each lap() gives the
+// time since the previous one to a phase, so every moment counts once. One
+// steady_clock read a lap and fixed storage: cheap enough for every control
+// step (~20 ns against a step of ~0.3 ms), and it never touches the results.
+enum Phase {
+  kEnvStep, kEnvReset, kActing, kHandover, kWaiting, kMotionUpdates, kDqn, kClassifier,
+  kEvaluation, kCheckpoint, kLogging, kOther, kPhases
+};
+struct Laps {
+  bool on = false;  // only inside Trainer::run()
+  Clock::time_point last;
+  std::array<Clock::duration, kPhases> spent{};
+  void start() {
+    on = true;
+    last = Clock::now();
+  }
+  void lap(Phase p) {
+    if (!on) return;
+    const Clock::time_point now = Clock::now();
+    spent[p] += now - last;
+    last = now;
+  }
+};
 
 // ---------------------------------------------------------------------------
 // Learners
@@ -148,6 +173,7 @@ struct LearnHooks {
   bool pilot_drives = false;
   double pilot_noise = 0;
   std::mt19937_64* pilot_rng = nullptr;
+  Laps* laps = nullptr;  // the trainer's timing (TrainerTiming)
 };
 
 // Reusable buffers of an episode runner (no allocation in the step loop).
@@ -216,6 +242,11 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
   const TrainerParams& t = c.trainer;
   int modules = c.trainer.fixed_modules;
   double return_r2 = 0;
+  Laps* laps = hooks ? hooks->laps : nullptr;
+  auto lap = [laps](Phase p) {
+    if (laps) laps->lap(p);
+  };
+  lap(kOther);
   auto choose = [&](rl::Observation& o) {
     int a = hooks && hooks->random_config ? hooks->random_config(b.mask) : -1;
     if (a < 0) {
@@ -231,13 +262,18 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
   if (hierarchical) {
     spec.modules = kMaxModules;
     env.reset(spec);
+    lap(kEnvReset);
     scene.reset(env);
+    lap(kClassifier);
     fill_config(env, t, kMaxModules, scene.current(), b, b.cobs);
     modules = choose(b.cobs);
+    lap(kDqn);
   }
   spec.modules = modules;
   env.reset(spec);
+  lap(kEnvReset);
   scene.reset(env);
+  lap(kClassifier);
   task::ScriptedPilot* pilot = hooks ? hooks->pilot : nullptr;
   if (pilot) pilot->plan(env);
   if (observe) (*observe)(env);
@@ -265,16 +301,21 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
       b.action.target.clear();
     }
     for (float a : b.action.continuous) saturated += std::abs(a) >= 0.99f;
+    lap(kActing);
     r = &env.step(b.action.continuous.data(), mode_of(scene.current()));
+    lap(kEnvStep);
     if (observe) (*observe)(env);
     segment.add_step(r->reward, r->stairs_climbed_now);
     log.return_R1 += r->reward;
     fill_motion(env, t, b.next);
+    lap(kActing);
     const bool done = r->terminated || r->truncated;
     if (hooks) hooks->motion(b.obs, b.action, static_cast<float>(r->reward), b.next, r->terminated, r->truncated);
+    lap(kHandover);
     std::swap(b.obs, b.next);
     if (done) break;
     const perception::SwitchDecision d = scene.step(env);
+    lap(kClassifier);
     if (!d.switched) continue;
     ++log.switches;
     if (!hierarchical) continue;
@@ -286,13 +327,16 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
     if (hooks) hooks->config(b.cobs, b.caction, static_cast<float>(r2), b.cnext, false, false, segment.steps());
     std::swap(b.cobs, b.cnext);
     const int next_modules = choose(b.cobs);
+    lap(kDqn);
     if (next_modules < modules) {
       env.reconfigure(next_modules);
       modules = next_modules;
+      lap(kEnvReset);
       fill_motion(env, t, b.obs);
     }
     if (log.configurations.back() != modules) log.configurations.push_back(modules);
     segment.begin(env.stairs_climbed(), env.stairs_energy());
+    lap(kActing);
   }
   // 4. The last segment.
   if (hierarchical) {
@@ -301,6 +345,7 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
     fill_config(env, t, modules, scene.current(), b, b.cnext);
     if (hooks)
       hooks->config(b.cobs, b.caction, static_cast<float>(r2), b.cnext, r->terminated, r->truncated, segment.steps());
+    lap(kDqn);
   }
 
   const task::Metrics m = env.metrics();
@@ -575,6 +620,16 @@ struct Trainer::Impl {
   Clock::time_point started = Clock::now();
   std::vector<double> recent_success;  // last 20 training episodes
 
+  // TrainerTiming: the acting thread's laps, run()'s wall time and checkpoints,
+  // and the learner's job time (written by the job, read after worker->wait()).
+  Laps laps;
+  Clock::duration run_time{}, learner_busy{};
+  int run_checkpoints = 0;
+  // measure_side_rates: when set, the acting side records its transitions
+  // here (preallocated) instead of handing them to the learner.
+  std::vector<Transition>* record = nullptr;
+  std::size_t recorded = 0;
+
   Impl(const CooptConfig& c, const std::string& dir, TrainerCallbacks cb)
       : config(c), run_dir(dir), callbacks(std::move(cb)), env(c.env), scene(c), rng(c.trainer.seed * 7919ULL + 17) {
     rl::set_torch_threads(c.trainer.torch_threads, 1);
@@ -605,38 +660,48 @@ struct Trainer::Impl {
   // Hands the filled transitions to the learner (after its previous job) and
   // refreshes the acting copy's weights from the learner.
   void hand_over() {
+    laps.lap(kHandover);
     worker->wait();
+    laps.lap(kWaiting);
     rl::copy_parameters(*networks_of(*agent.motion), *networks_of(*learner));
+    laps.lap(kHandover);
     if (filled == 0) return;
     std::vector<Transition>* batch = &pending[filling];
     const int n = filled;
     filling = 1 - filling;
     filled = 0;
     rl::Learner* l = learner.get();
-    worker->submit([l, batch, n] {
+    Clock::duration* busy = &learner_busy;
+    worker->submit([l, batch, n, busy] {
+      const Clock::time_point start = Clock::now();
       for (int i = 0; i < n; ++i) {
         const Transition& t = (*batch)[i];
         l->store(t.obs, t.action, t.reward, t.next, t.terminated, t.truncated);
         for (int u = l->updates_due(); u > 0; --u) l->update();
       }
+      *busy += Clock::now() - start;
     });
+    laps.lap(config.trainer.learner_thread ? kHandover : kMotionUpdates);  // inline: the job ran in submit()
   }
 
   // Episode end: everything handed over and learnt, acting copy up to date.
   void full_sync() {
     hand_over();
     worker->wait();
+    laps.lap(kWaiting);
     rl::copy_parameters(*networks_of(*agent.motion), *networks_of(*learner));
+    laps.lap(kHandover);
   }
 
   EpisodeLog train_episode() {
     const TrainerParams& t = config.trainer;
     const bool warmup = episode < t.warmup_episodes;
     LearnHooks hooks;
+    hooks.laps = &laps;
     hooks.motion = [this](const rl::Observation& o, const rl::Action& a, float r, const rl::Observation& n,
                           bool term, bool trunc) {
       agent.motion->store(o, a, r, n, term, trunc);  // keeps the acting copy's exploration counters
-      Transition& tr = pending[filling][filled++];
+      Transition& tr = record ? (*record)[recorded++] : pending[filling][filled++];
       tr.obs.image = o.image;  // same sizes: copies, no allocation
       tr.obs.vector = o.vector;
       tr.next.image = n.image;
@@ -647,7 +712,7 @@ struct Trainer::Impl {
       tr.terminated = term;
       tr.truncated = trunc;
       ++steps;
-      if (filled == config.trainer.sync_interval) hand_over();
+      if (!record && filled == config.trainer.sync_interval) hand_over();
     };
     hooks.config = [this](const rl::Observation& o, const rl::Action& a, float r2, const rl::Observation& n,
                           bool term, bool trunc, int k) {
@@ -691,7 +756,7 @@ struct Trainer::Impl {
     scenario_settings(t.scenario, spec.obstacles, mixed);
     spec.variant = mixed ? sim::Variant::mixed : sim::Variant::standard;
     EpisodeLog log = play(config, agent, env, scene, spec, true, &hooks, buffers);
-    full_sync();
+    if (!record) full_sync();
     log.episode = episode;
     log.warmup = warmup;
     return log;
@@ -814,28 +879,156 @@ int Trainer::evaluations_done() const { return impl_->evaluations; }
 std::int64_t Trainer::env_steps() const { return impl_->steps; }
 double Trainer::wall_s() const { return impl_->wall(); }
 
+TrainerTiming Trainer::timing() const {
+  const Impl& m = *impl_;
+  auto s = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
+  TrainerTiming t;
+  t.wall_s = s(m.run_time);
+  using Field = double TrainerTiming::*;
+  const std::pair<Phase, Field> fields[] = {
+      {kEnvStep, &TrainerTiming::env_step_s},       {kEnvReset, &TrainerTiming::env_reset_s},
+      {kActing, &TrainerTiming::acting_s},          {kHandover, &TrainerTiming::handover_s},
+      {kWaiting, &TrainerTiming::waiting_s},        {kMotionUpdates, &TrainerTiming::motion_updates_s},
+      {kDqn, &TrainerTiming::dqn_s},                {kClassifier, &TrainerTiming::classifier_s},
+      {kEvaluation, &TrainerTiming::evaluation_s},  {kCheckpoint, &TrainerTiming::checkpoint_s},
+      {kLogging, &TrainerTiming::logging_s},        {kOther, &TrainerTiming::other_s}};
+  for (const auto& [phase, field] : fields) t.*field = s(m.laps.spent[phase]);
+  t.learner_busy_s = s(m.learner_busy);
+  t.checkpoints = m.run_checkpoints;
+  return t;
+}
+
 bool Trainer::run(const std::atomic<bool>* stop) {
   Impl& m = *impl_;
   const TrainerParams& t = m.config.trainer;
   const int total = t.warmup_episodes + t.episodes;
+  // run()'s time is timed, and every return (or exception) ends the laps.
+  struct RunClock {
+    Impl& m;
+    Clock::time_point start = Clock::now();
+    explicit RunClock(Impl& impl) : m(impl) { m.laps.start(); }
+    ~RunClock() {
+      m.laps.lap(kOther);
+      m.laps.on = false;
+      m.run_time += Clock::now() - start;
+    }
+  } run_clock(m);
+  auto checkpoint = [&] {
+    m.save_checkpoint();
+    m.laps.lap(kCheckpoint);
+    ++m.run_checkpoints;
+  };
   while (m.episode < total) {
     if (stop && stop->load()) {
-      m.save_checkpoint();
+      checkpoint();
       return false;
     }
     const EpisodeLog log = m.train_episode();
     ++m.episode;
+    m.laps.lap(kOther);
     if (m.callbacks.on_episode) m.callbacks.on_episode(log);
     m.progress(log);
+    m.laps.lap(kLogging);
     const bool last = m.episode == total;
     if (t.eval_interval > 0 && (m.episode % t.eval_interval == 0 || last)) {
       const EvaluationLog e = m.periodic_evaluation();
       ++m.evaluations;
+      m.laps.lap(kEvaluation);
       if (m.callbacks.on_evaluation) m.callbacks.on_evaluation(e);
+      m.laps.lap(kLogging);
     }
-    if (m.episode % t.checkpoint_interval == 0 || last) m.save_checkpoint();
+    if (m.episode % t.checkpoint_interval == 0 || last) checkpoint();
   }
   return true;
+}
+
+// ---------------------------------------------------------------------------
+// Benchmark support (bench/coopt/bench_trainer).
+
+SideRates measure_side_rates(const CooptConfig& config, std::int64_t steps) {
+  if (steps < 1) throw std::invalid_argument("measure_side_rates: steps must be >= 1");
+  Trainer::Impl m(config, "", {});
+  const TrainerParams& t = config.trainer;
+  const int total = t.warmup_episodes + t.episodes;
+  // The last episode may run past `steps` by up to a whole episode.
+  std::vector<Transition> record(static_cast<std::size_t>(steps + config.env.task.max_steps + 1));
+  for (Transition& tr : record) {
+    rl::allocate(motion_spec(config), tr.obs);
+    rl::allocate(motion_spec(config), tr.next);
+    tr.action.continuous.assign(control::kActionSize, 0.0f);
+    tr.action.target.assign(control::kActionSize, 0.0f);  // so that copying a target does not allocate
+  }
+  m.record = &record;
+  SideRates rates;
+  Clock::time_point start = Clock::now();
+  while (static_cast<std::int64_t>(m.recorded) < steps && m.episode < total) {
+    m.train_episode();
+    ++m.episode;
+  }
+  rates.acting_steps = static_cast<std::int64_t>(m.recorded);
+  rates.acting_steps_per_s =
+      static_cast<double>(m.recorded) / std::chrono::duration<double>(Clock::now() - start).count();
+
+  // The learner alone on those transitions; its first updates start the clock
+  // (before learning_starts a step costs only the store).
+  rl::Learner& l = *m.learner;
+  std::size_t i = 0;
+  bool learning = false;
+  auto learn = [&](const Transition& tr) {
+    l.store(tr.obs, tr.action, tr.reward, tr.next, tr.terminated, tr.truncated);
+    int due = l.updates_due();
+    learning = learning || due > 0;
+    for (; due > 0; --due) l.update();
+  };
+  while (i < m.recorded && !learning) learn(record[i++]);
+  if (!learning)
+    throw std::runtime_error("measure_side_rates: " + std::to_string(m.recorded) +
+                             " control steps never reached the motion learner's learning_starts; give more steps");
+  const std::size_t first_timed = i;
+  start = Clock::now();
+  while (i < m.recorded) learn(record[i++]);
+  rates.learner_steps = static_cast<std::int64_t>(m.recorded - first_timed);
+  const double learner_s = std::chrono::duration<double>(Clock::now() - start).count();
+  rates.learner_steps_per_s = learner_s > 0 ? static_cast<double>(rates.learner_steps) / learner_s : 0.0;
+  return rates;
+}
+
+CheckpointCost measure_checkpoint_cost(const CooptConfig& config, const std::string& run_dir,
+                                       std::int64_t transitions, std::int64_t new_transitions) {
+  Trainer::Impl m(config, run_dir, {});
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  rl::Observation o, next, co, cnext;
+  rl::allocate(motion_spec(config), o);
+  rl::allocate(motion_spec(config), next);
+  rl::allocate(config_spec(config), co);
+  rl::allocate(config_spec(config), cnext);
+  rl::Action a, ca;
+  a.continuous.assign(control::kActionSize, 0.5f);
+  if (config.trainer.pilot_labels) a.target.assign(control::kActionSize, 0.5f);
+  std::int64_t stored = 0;
+  auto fill = [&](std::int64_t n) {
+    for (std::int64_t k = 0; k < n; ++k, ++stored) {
+      for (float& x : o.vector) x = u(rng);
+      for (float& x : o.image) x = u(rng);
+      m.learner->store(o, a, u(rng), next, false, false);
+      if (m.agent.config && stored % 600 == 0) {
+        for (float& x : co.image) x = u(rng);
+        ca.discrete = static_cast<int>(stored / 600 % kCandidates);
+        m.agent.config->store(co, ca, u(rng), cnext, false, false, 300);
+      }
+    }
+  };
+  CheckpointCost cost;
+  fill(transitions);
+  Clock::time_point start = Clock::now();
+  m.save_checkpoint();
+  cost.first_s = std::chrono::duration<double>(Clock::now() - start).count();
+  fill(new_transitions);
+  start = Clock::now();
+  m.save_checkpoint();
+  cost.next_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return cost;
 }
 
 // ---------------------------------------------------------------------------

@@ -108,6 +108,30 @@ void check_same_run(const CheckpointInfo& info, const CooptConfig& config, const
 // Keeps the header and the first `rows` data rows of a CSV file (resume after a kill).
 void truncate_csv_rows(const std::string& path, int rows);
 
+// Where Trainer::run() spent its wall time, s, for bench/coopt/bench_trainer
+// (docs/coopt.md, "Throughput"). Every moment of the acting (calling) thread
+// falls in exactly one of its fields (steady_clock laps, no allocation), so
+// they add up to wall_s; motion_updates_s is on that thread only without a
+// learner thread (trainer.learner_thread: false). learner_busy_s is the time
+// the learner spent in its jobs (store + updates), on whichever thread ran them.
+struct TrainerTiming {
+  double wall_s = 0;            // run() calls of this object, summed
+  double env_step_s = 0;        // MultiTaskEnv::step
+  double env_reset_s = 0;       // resets (MJCF built for the chain) and reconfigurations
+  double acting_s = 0;          // the motion model's act(), the scripted pilot, building observations
+  double handover_s = 0;        // transitions into the hand-over buffer, the acting copy's store, weight copies
+  double waiting_s = 0;         // waiting for the learner's previous job
+  double motion_updates_s = 0;  // store + updates run inline (learner_thread: false)
+  double dqn_s = 0;             // the configuration model: observation, act, store, updates
+  double classifier_s = 0;      // the scene source (switch detector, classifier forward passes)
+  double evaluation_s = 0;      // periodic greedy evaluations
+  double checkpoint_s = 0;      // writing checkpoints (after waiting for the learner)
+  double logging_s = 0;         // callbacks (CSV rows) and progress lines
+  double other_s = 0;           // the rest (episode bookkeeping)
+  double learner_busy_s = 0;    // the learner's jobs: replay store + gradient updates
+  int checkpoints = 0;          // checkpoints written by run()
+};
+
 class Trainer {
  public:
   // run_dir must exist; checkpoints go to run_dir/checkpoint, evaluations.csv is written there.
@@ -127,12 +151,39 @@ class Trainer {
   int evaluations_done() const;
   std::int64_t env_steps() const;
   double wall_s() const;  // training wall time including resumed parts
+  TrainerTiming timing() const;
 
   struct Impl;
 
  private:
   std::unique_ptr<Impl> impl_;
 };
+
+// Each side of the trainer alone, for bench/coopt/bench_trainer: the acting
+// side (the trainer's own training episodes: env, acting copy, pilot, scene
+// source, DQN) for at least `steps` control steps without a learner, then the
+// motion learner alone (store + the updates the config asks for) on the
+// transitions those episodes produced, timed after its learning_starts.
+// In control steps per second of wall time; both run on the calling thread.
+struct SideRates {
+  double acting_steps_per_s = 0;
+  double learner_steps_per_s = 0;
+  std::int64_t acting_steps = 0;   // control steps the acting side ran (whole episodes)
+  std::int64_t learner_steps = 0;  // transitions the timed learner part stored
+};
+SideRates measure_side_rates(const CooptConfig& config, std::int64_t steps);
+
+// Wall time of two successive Trainer checkpoints into run_dir (which must
+// exist): the first after `transitions` transitions were stored in the motion
+// learner's replay (and one configuration-model transition per 600 of them,
+// about 2.5 decisions per 1500-step episode), the second after `new_transitions` more.
+// Random observations: only the sizes matter to the write.
+struct CheckpointCost {
+  double first_s = 0;
+  double next_s = 0;
+};
+CheckpointCost measure_checkpoint_cost(const CooptConfig& config, const std::string& run_dir,
+                                       std::int64_t transitions, std::int64_t new_transitions);
 
 // `comorph eval`: greedy episodes of a trained run on the paper's protocol.
 struct EvalRequest {
