@@ -30,9 +30,17 @@ std::string file_checksum(const std::string& path) {
 }
 
 void write_checksums(const std::string& dir, const std::vector<std::string>& names) {
+  write_checksums(dir, names, {});
+}
+
+void write_checksums(const std::string& dir, const std::vector<std::string>& names,
+                     const std::map<std::string, std::string>& known) {
   namespace fs = std::filesystem;
   std::string text;
-  for (const auto& name : names) text += file_checksum((fs::path(dir) / name).string()) + "  " + name + "\n";
+  for (const auto& name : names) {
+    const auto sum = known.find(name);
+    text += (sum != known.end() ? sum->second : file_checksum((fs::path(dir) / name).string())) + "  " + name + "\n";
+  }
   write_file_atomic((fs::path(dir) / kChecksumFile).string(), text);
 }
 

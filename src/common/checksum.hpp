@@ -7,6 +7,7 @@
 // and it needs no library.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,10 @@ inline constexpr const char* kChecksumFile = "checksums.txt";
 // Writes dir/checksums.txt ("<sum>  <name>" a line) for the given files of
 // `dir`; call it after the files are complete (checked write + rename).
 void write_checksums(const std::string& dir, const std::vector<std::string>& names);
+// The same, with the sums of some files already known (name -> sum): files
+// hard-linked unchanged from an earlier checkpoint are not read again.
+void write_checksums(const std::string& dir, const std::vector<std::string>& names,
+                     const std::map<std::string, std::string>& known);
 // "" when every file listed in dir/checksums.txt has its sum; otherwise what
 // is wrong, naming the file ("dir/motion.pt: checksum mismatch (...)").
 // `missing_ok`: a directory without checksums.txt (written before checksums

@@ -23,6 +23,7 @@
 #include "perception/scene_monitor.hpp"
 #include "perception/switch_detector.hpp"
 #include "rl/dqn.hpp"
+#include "rl/replay_segments.hpp"
 #include "rl/sac.hpp"
 #include "rl/td3.hpp"
 #include "sim/scene.hpp"
@@ -484,11 +485,20 @@ void load_checkpoint_file(Model& model, const std::string& path) {
   }
 }
 
-// The files of a checkpoint directory (all but checksums.txt).
-std::vector<std::string> checkpoint_files(bool with_config_model) {
-  std::vector<std::string> names{"motion.pt", "motion_actor.pt", "trainer.yaml"};
-  if (with_config_model) names.push_back("config_model.pt");
-  return names;
+// A learner's replay from its checkpoint's segments (rl/replay_segments.hpp;
+// an older checkpoint's learner file held it, and then there is no index).
+// Every transition the learner counts must be back: a missing index would
+// otherwise resume with an empty buffer.
+rl::ReplaySegments load_replay(rl::Learner& learner, const std::string& name, const std::string& dir) {
+  rl::ReplaySegments segments = rl::read_replay_segments(learner.replay(), name, dir);
+  const rl::ReplayBuffer& replay = learner.replay();
+  const std::int64_t expected = std::min(learner.counters().transitions, replay.capacity());
+  if (replay.size() != expected)
+    throw std::runtime_error((fs::path(dir) / rl::replay_index_name(name)).string() + ": the replay holds " +
+                             std::to_string(replay.size()) + " transitions, the learner stored " +
+                             std::to_string(learner.counters().transitions) + " (capacity " +
+                             std::to_string(replay.capacity()) + ")");
+  return segments;
 }
 
 std::string first_difference(const std::string& a, const std::string& b) {
@@ -629,6 +639,9 @@ struct Trainer::Impl {
   // here (preallocated) instead of handing them to the learner.
   std::vector<Transition>* record = nullptr;
   std::size_t recorded = 0;
+  // The replay segments of the last checkpoint written or loaded: the next
+  // checkpoint links those and writes only what was added since.
+  rl::ReplaySegments motion_segments, config_segments;
 
   Impl(const CooptConfig& c, const std::string& dir, TrainerCallbacks cb)
       : config(c), run_dir(dir), callbacks(std::move(cb)), env(c.env), scene(c), rng(c.trainer.seed * 7919ULL + 17) {
@@ -803,8 +816,9 @@ struct Trainer::Impl {
     const std::string tmp = dir + ".tmp", old = dir + ".old";
     fs::remove_all(tmp);
     fs::create_directories(tmp);
+    rl::ReplaySegments motion_next, config_next;
     try {
-      write_checkpoint_files(tmp);
+      write_checkpoint_files(tmp, motion_next, config_next);
     } catch (...) {
       // A full disk: the last good checkpoint stays; free what the partial one took.
       std::error_code ignored;
@@ -819,16 +833,33 @@ struct Trainer::Impl {
     // Swap directories: a crash at any point leaves either `checkpoint` or
     // `checkpoint.old` complete (read_checkpoint_info falls back to .old).
     // checkpoint.old stays as the fallback when `checkpoint` is found damaged.
+    // The replay segments live in each directory that needs them (hard
+    // links), so removing checkpoint.old takes nothing from the others.
     fs::remove_all(old);
     if (fs::exists(dir)) fs::rename(dir, old);
     fs::rename(tmp, dir);
+    motion_segments = motion_next;
+    motion_segments.directory = dir;
+    config_segments = config_next;
+    config_segments.directory = dir;
   }
 
-  // The files of a checkpoint into `tmp`, the checksums last.
-  void write_checkpoint_files(const std::string& tmp) {
-    learner->save((fs::path(tmp) / "motion.pt").string());
-    agent.motion->save((fs::path(tmp) / "motion_actor.pt").string());
-    if (agent.config) agent.config->save((fs::path(tmp) / "config_model.pt").string());
+  // The files of a checkpoint into `tmp`, the checksums last. The replay
+  // buffers go apart from their learners, as segments: only the transitions
+  // added since the last checkpoint are written (rl/replay_segments.hpp).
+  void write_checkpoint_files(const std::string& tmp, rl::ReplaySegments& motion_next,
+                              rl::ReplaySegments& config_next) {
+    std::vector<std::string> files{"motion.pt", "motion_actor.pt", "trainer.yaml"};
+    std::map<std::string, std::string> sums;  // of linked segments, known without reading them
+    learner->save_without_replay((fs::path(tmp) / "motion.pt").string());
+    motion_next = rl::write_replay_segments(learner->replay(), "motion", tmp, motion_segments, files, sums);
+    agent.motion->save((fs::path(tmp) / "motion_actor.pt").string());  // the acting copy: a one-slot replay
+    if (agent.config) {
+      agent.config->save_without_replay((fs::path(tmp) / "config_model.pt").string());
+      files.push_back("config_model.pt");
+      config_next =
+          rl::write_replay_segments(agent.config->replay(), "config_model", tmp, config_segments, files, sums);
+    }
     YAML::Emitter e;
     e << YAML::BeginMap;
     e << YAML::Key << "episodes" << YAML::Value << episode;
@@ -842,7 +873,7 @@ struct Trainer::Impl {
     e << YAML::Key << "config" << YAML::Value << YAML::Literal << config.text;
     e << YAML::EndMap;
     write_text_file((fs::path(tmp) / "trainer.yaml").string(), e.c_str());
-    write_checksums(tmp, checkpoint_files(agent.config != nullptr));
+    write_checksums(tmp, files, sums);
   }
 
   void load_checkpoint() {
@@ -854,8 +885,12 @@ struct Trainer::Impl {
       throw std::runtime_error(std::string(e.what()) + "; refusing to resume");
     }
     load_checkpoint_file(*learner, (fs::path(info.directory) / "motion.pt").string());
+    motion_segments = load_replay(*learner, "motion", info.directory);
     load_checkpoint_file(*agent.motion, (fs::path(info.directory) / "motion_actor.pt").string());
-    if (agent.config) load_checkpoint_file(*agent.config, (fs::path(info.directory) / "config_model.pt").string());
+    if (agent.config) {
+      load_checkpoint_file(*agent.config, (fs::path(info.directory) / "config_model.pt").string());
+      config_segments = load_replay(*agent.config, "config_model", info.directory);
+    }
     const YAML::Node n = load_yaml_file((fs::path(info.directory) / "trainer.yaml").string());
     rl::set_rng_state(rng, n["rng"].as<std::string>());
     episode = info.episodes;

@@ -135,17 +135,19 @@ void Dqn::update() {
   }
 }
 
-void Dqn::save(const std::string& path) const {
-  torch::serialize::OutputArchive a, nets, target, opt, replay;
+void Dqn::save(const std::string& path) const { save_to(path, true); }
+void Dqn::save_without_replay(const std::string& path) const { save_to(path, false); }
+
+void Dqn::save_to(const std::string& path, bool with_replay) const {
+  torch::serialize::OutputArchive a, nets, target, opt;
   write_common(a, counters_, rng_, "dqn");
   q_->save(nets);
   q_target_->save(target);
   optimizer_->save(opt);
-  replay_.save(replay);
   a.write("q", nets);
   a.write("q_target", target);
   a.write("optimizer", opt);
-  a.write("replay", replay);
+  write_replay(a, replay_, with_replay);
   save_archive(a, path);
 }
 
@@ -154,18 +156,17 @@ void Dqn::save_policy(const std::string& path) const {
 }
 
 void Dqn::load(const std::string& path) {
-  torch::serialize::InputArchive a, nets, target, opt, replay;
+  torch::serialize::InputArchive a, nets, target, opt;
   a.load_from(path, device_);
   read_common(a, counters_, rng_, "dqn");
   if (read_policy_only(a, "q", *q_)) return;
   a.read("q", nets);
   a.read("q_target", target);
   a.read("optimizer", opt);
-  a.read("replay", replay);
   q_->load(nets);
   q_target_->load(target);
   optimizer_->load(opt);
-  replay_.load(replay);
+  read_replay(a, replay_);
 }
 
 }  // namespace comorph::rl

@@ -62,6 +62,7 @@ class Dqn final : public Learner {
   int updates_due() const override;
   void update() override;
   void save(const std::string& path) const override;
+  void save_without_replay(const std::string& path) const override;
   void load(const std::string& path) override;
   void save_policy(const std::string& path) const override;
   const LearnerCounters& counters() const override { return counters_; }
@@ -74,11 +75,12 @@ class Dqn final : public Learner {
   // Q values of one observation (greedy diagnostics, tests).
   std::vector<float> q_values(const Observation& observation);
   const DqnConfig& config() const { return config_; }
-  ReplayBuffer& replay() { return replay_; }
+  ReplayBuffer& replay() override { return replay_; }
   QNetwork& q_network() { return q_; }
   QNetwork& target_network() { return q_target_; }
 
  private:
+  void save_to(const std::string& path, bool with_replay) const;
   ObservationSpec spec_;
   int num_actions_;
   DqnConfig config_;

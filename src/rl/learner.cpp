@@ -7,6 +7,8 @@
 #include <optional>
 #include <sstream>
 
+#include "rl/replay_buffer.hpp"
+
 namespace comorph::rl {
 
 std::string rl_config_dir() { return std::string(COMORPH_SOURCE_DIR) + "/configs/rl"; }
@@ -89,6 +91,24 @@ bool read_policy_only(torch::serialize::InputArchive& a, const std::string& key,
   a.read(key, nets);
   networks.load(nets);
   return true;
+}
+
+void write_replay(torch::serialize::OutputArchive& a, const ReplayBuffer& replay, bool with_replay) {
+  if (!with_replay) {
+    a.write("replay_elsewhere", c10::IValue(true));
+    return;
+  }
+  torch::serialize::OutputArchive r;
+  replay.save(r);
+  a.write("replay", r);
+}
+
+void read_replay(torch::serialize::InputArchive& a, ReplayBuffer& replay) {
+  c10::IValue elsewhere;
+  if (a.try_read("replay_elsewhere", elsewhere) && elsewhere.toBool()) return;
+  torch::serialize::InputArchive r;
+  a.read("replay", r);
+  replay.load(r);
 }
 
 void read_common(torch::serialize::InputArchive& a, LearnerCounters& c, std::mt19937_64& rng,

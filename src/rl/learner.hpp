@@ -34,6 +34,8 @@ class InputArchive;
 
 namespace comorph::rl {
 
+class ReplayBuffer;  // rl/replay_buffer.hpp
+
 // Counters every learner keeps; all are part of a checkpoint.
 struct LearnerCounters {
   std::int64_t transitions = 0;  // store() calls
@@ -64,6 +66,11 @@ class Learner {
   // file the learner acts as the saved one did (greedy), and everything else
   // stays as constructed, so it cannot continue training exactly.
   virtual void save_policy(const std::string& path) const = 0;
+  // The replay buffer, and save() without it: the hierarchical trainer writes
+  // the buffer apart, as segments (rl/replay_segments.hpp). load() of such a
+  // file leaves replay() as it is.
+  virtual ReplayBuffer& replay() = 0;
+  virtual void save_without_replay(const std::string& path) const = 0;
   virtual const LearnerCounters& counters() const = 0;
   // Loss of the latest update() (critic / Q loss), for logs.
   virtual double last_loss() const = 0;
@@ -149,5 +156,9 @@ void read_common(torch::serialize::InputArchive& archive, LearnerCounters& count
 void save_policy_file(const std::string& path, const torch::nn::Module& networks, const std::string& key,
                       const LearnerCounters& counters, const std::mt19937_64& rng, const std::string& algorithm);
 bool read_policy_only(torch::serialize::InputArchive& archive, const std::string& key, torch::nn::Module& networks);
+// A learner archive's replay: the buffer under "replay", or (with_replay
+// false) a mark that it is written elsewhere; read_replay reads either.
+void write_replay(torch::serialize::OutputArchive& archive, const ReplayBuffer& replay, bool with_replay);
+void read_replay(torch::serialize::InputArchive& archive, ReplayBuffer& replay);
 
 }  // namespace comorph::rl

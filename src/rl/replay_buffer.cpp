@@ -109,6 +109,7 @@ void ReplayBuffer::add(const Observation& obs, const Action& action, float rewar
   has_target_.data_ptr<float>()[slot] = action.target.empty() ? 0.0f : 1.0f;
   position_ = (position_ + 1) % capacity_;
   size_ = std::min(size_ + 1, capacity_);
+  ++added_;
 }
 
 torch::Tensor ReplayBuffer::images_as_float(const torch::Tensor& storage,
@@ -156,6 +157,7 @@ void ReplayBuffer::save(torch::serialize::OutputArchive& a) const {
   a.write("capacity", torch::tensor({capacity_}));
   a.write("size", torch::tensor({size_}));
   a.write("position", torch::tensor({position_}));
+  a.write("added", torch::tensor({added_}));
   a.write("image_storage", torch::tensor({static_cast<std::int64_t>(image_storage_)}));
   if (image_.defined()) {
     a.write("image", filled(image_));
@@ -188,6 +190,11 @@ void ReplayBuffer::load(torch::serialize::InputArchive& a) {
   size_ = t.item<std::int64_t>();
   a.read("position", t);
   position_ = t.item<std::int64_t>();
+  // Buffers saved before `added` was kept: a count with the same slots.
+  if (a.try_read("added", t))
+    added_ = t.item<std::int64_t>();
+  else
+    added_ = size_ < capacity_ ? size_ : capacity_ + position_;
   auto restore = [&](const char* key, torch::Tensor& dst) {
     torch::Tensor src;
     a.read(key, src);
@@ -217,6 +224,86 @@ void ReplayBuffer::load(torch::serialize::InputArchive& a) {
     if (target_.defined()) restore("target", target_);
   }
   if (next_valid_.defined()) restore("next_valid", next_valid_);
+}
+
+std::vector<std::pair<std::string, torch::Tensor>> ReplayBuffer::fields() const {
+  std::vector<std::pair<std::string, torch::Tensor>> f;
+  for (const auto& [key, t] : {std::pair<const char*, const torch::Tensor*>{"image", &image_},
+                               {"next_image", &next_image_}, {"vector", &vector_}, {"next_vector", &next_vector_},
+                               {"action", &action_}, {"reward", &reward_}, {"discount", &discount_},
+                               {"terminated", &terminated_}, {"next_valid", &next_valid_}, {"target", &target_},
+                               {"has_target", &has_target_}})
+    if (t->defined()) f.emplace_back(key, *t);
+  return f;
+}
+
+namespace {
+// The slots of `count` transitions from global index `first`: at most two
+// contiguous runs (the ring wraps once). fn(slot, offset in the run of transitions, length).
+template <class F>
+void for_slot_runs(std::int64_t first, std::int64_t count, std::int64_t capacity, F fn) {
+  std::int64_t offset = 0;
+  while (offset < count) {
+    const std::int64_t slot = (first + offset) % capacity;
+    const std::int64_t length = std::min(count - offset, capacity - slot);
+    fn(slot, offset, length);
+    offset += length;
+  }
+}
+}  // namespace
+
+void ReplayBuffer::save_segment(torch::serialize::OutputArchive& a, std::int64_t first, std::int64_t count) const {
+  if (count < 0 || first < added_ - size_ || first + count > added_)
+    throw std::logic_error("ReplayBuffer::save_segment: transitions [" + std::to_string(first) + ", " +
+                           std::to_string(first + count) + ") are not all held (held: [" +
+                           std::to_string(added_ - size_) + ", " + std::to_string(added_) + "))");
+  a.write("first", torch::tensor({first}));
+  a.write("count", torch::tensor({count}));
+  a.write("image_storage", torch::tensor({static_cast<std::int64_t>(image_storage_)}));
+  for (const auto& [key, storage] : fields()) {
+    std::vector<torch::Tensor> runs;
+    for_slot_runs(first, count, capacity_, [&](std::int64_t slot, std::int64_t, std::int64_t length) {
+      runs.push_back(storage.slice(0, slot, slot + length));
+    });
+    a.write(key, runs.empty() ? storage.slice(0, 0, 0).clone() : torch::cat(runs));
+  }
+}
+
+void ReplayBuffer::begin_segments(std::int64_t added) {
+  if (added < 0) throw std::runtime_error("ReplayBuffer: a negative transition count " + std::to_string(added));
+  added_ = added;
+  size_ = std::min(added, capacity_);
+  position_ = added % capacity_;
+}
+
+void ReplayBuffer::load_segment(torch::serialize::InputArchive& a, std::int64_t first, std::int64_t count) {
+  torch::Tensor t;
+  a.read("first", t);
+  const std::int64_t saved_first = t.item<std::int64_t>();
+  a.read("count", t);
+  const std::int64_t saved_count = t.item<std::int64_t>();
+  if (saved_first != first || saved_count != count)
+    throw std::runtime_error("replay segment holds transitions [" + std::to_string(saved_first) + ", " +
+                             std::to_string(saved_first + saved_count) + "), its index says [" +
+                             std::to_string(first) + ", " + std::to_string(first + count) + ")");
+  a.read("image_storage", t);
+  if (t.item<std::int64_t>() != static_cast<std::int64_t>(image_storage_))
+    throw std::runtime_error("replay segment: saved image storage type differs");
+  // Only the part that is still held: the last size_ transitions.
+  const std::int64_t from = std::max(first, added_ - size_);
+  const std::int64_t to = std::min(first + count, added_);
+  for (const auto& [key, storage] : fields()) {
+    torch::Tensor src;
+    a.read(key, src);
+    if (src.size(0) != count || src.sizes().slice(1) != storage.sizes().slice(1) ||
+        src.scalar_type() != storage.scalar_type())
+      throw std::runtime_error("replay segment: field \"" + key + "\" has the wrong shape or type for this buffer");
+    if (to <= from) continue;
+    for_slot_runs(from, to - from, capacity_, [&](std::int64_t slot, std::int64_t offset, std::int64_t length) {
+      const std::int64_t at = from - first + offset;
+      storage.slice(0, slot, slot + length).copy_(src.slice(0, at, at + length));
+    });
+  }
 }
 
 void ReplayBuffer::save(const std::string& path) const {

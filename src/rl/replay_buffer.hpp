@@ -17,6 +17,8 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "rl/env.hpp"
 
@@ -56,6 +58,9 @@ class ReplayBuffer {
   std::int64_t size() const { return size_; }
   std::int64_t capacity() const { return capacity_; }
   std::int64_t next_slot() const { return position_; }
+  // Transitions ever added = the global index of the next one. Transition g
+  // is in slot g % capacity while it is among the last size() (g >= added() - size()).
+  std::int64_t added() const { return added_; }
   const ObservationSpec& observation_spec() const { return obs_spec_; }
 
   void save(torch::serialize::OutputArchive& archive) const;
@@ -63,8 +68,20 @@ class ReplayBuffer {
   void save(const std::string& path) const;
   void load(const std::string& path);
 
+  // Segments (rl/replay_segments.hpp: a checkpoint writes only what is new).
+  // save_segment: transitions [first, first + count) by global index, which
+  // must all still be held. To read segments back, begin_segments(added) sets
+  // the counts of a buffer that has had `added` transitions, then each
+  // load_segment(first, count) puts those of its transitions that are still
+  // held (the last min(added, capacity)) into their slots.
+  void save_segment(torch::serialize::OutputArchive& archive, std::int64_t first, std::int64_t count) const;
+  void begin_segments(std::int64_t added);
+  void load_segment(torch::serialize::InputArchive& archive, std::int64_t first, std::int64_t count);
+
  private:
   void store_image(const std::vector<float>& image, torch::Tensor& storage, std::int64_t slot);
+  // Every storage tensor with its archive key (those this buffer has).
+  std::vector<std::pair<std::string, torch::Tensor>> fields() const;
   torch::Tensor images_as_float(const torch::Tensor& storage, const torch::Tensor& slots) const;
 
   ObservationSpec obs_spec_;
@@ -73,6 +90,7 @@ class ReplayBuffer {
   ImageStorage image_storage_;
   std::int64_t size_ = 0;
   std::int64_t position_ = 0;
+  std::int64_t added_ = 0;
 
   torch::Tensor image_, next_image_, vector_, next_vector_;
   torch::Tensor action_, reward_, discount_, terminated_, next_valid_, target_, has_target_;

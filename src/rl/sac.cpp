@@ -183,22 +183,24 @@ void Sac::update() {
   }
 }
 
-void Sac::save(const std::string& path) const {
-  torch::serialize::OutputArchive a, nets, target, actor_opt, critic_opt, alpha_opt, replay;
+void Sac::save(const std::string& path) const { save_to(path, true); }
+void Sac::save_without_replay(const std::string& path) const { save_to(path, false); }
+
+void Sac::save_to(const std::string& path, bool with_replay) const {
+  torch::serialize::OutputArchive a, nets, target, actor_opt, critic_opt, alpha_opt;
   write_common(a, counters_, rng_, "sac");
   nets_->save(nets);
   target_->save(target);
   actor_optimizer_->save(actor_opt);
   critic_optimizer_->save(critic_opt);
   alpha_optimizer_->save(alpha_opt);
-  replay_.save(replay);
   a.write("networks", nets);
   a.write("target_networks", target);
   a.write("log_alpha", log_alpha_.detach());
   a.write("actor_optimizer", actor_opt);
   a.write("critic_optimizer", critic_opt);
   a.write("alpha_optimizer", alpha_opt);
-  a.write("replay", replay);
+  write_replay(a, replay_, with_replay);
   save_archive(a, path);
 }
 
@@ -207,7 +209,7 @@ void Sac::save_policy(const std::string& path) const {
 }
 
 void Sac::load(const std::string& path) {
-  torch::serialize::InputArchive a, nets, target, actor_opt, critic_opt, alpha_opt, replay;
+  torch::serialize::InputArchive a, nets, target, actor_opt, critic_opt, alpha_opt;
   a.load_from(path, device_);
   read_common(a, counters_, rng_, "sac");
   if (read_policy_only(a, "networks", *nets_)) return;
@@ -216,7 +218,6 @@ void Sac::load(const std::string& path) {
   a.read("actor_optimizer", actor_opt);
   a.read("critic_optimizer", critic_opt);
   a.read("alpha_optimizer", alpha_opt);
-  a.read("replay", replay);
   nets_->load(nets);
   target_->load(target);
   torch::Tensor log_alpha;
@@ -228,7 +229,7 @@ void Sac::load(const std::string& path) {
   actor_optimizer_->load(actor_opt);
   critic_optimizer_->load(critic_opt);
   alpha_optimizer_->load(alpha_opt);
-  replay_.load(replay);
+  read_replay(a, replay_);
 }
 
 }  // namespace comorph::rl

@@ -63,6 +63,7 @@ class Sac final : public Learner {
   int updates_due() const override;
   void update() override;
   void save(const std::string& path) const override;
+  void save_without_replay(const std::string& path) const override;
   void load(const std::string& path) override;
   void save_policy(const std::string& path) const override;
   const LearnerCounters& counters() const override { return counters_; }
@@ -71,9 +72,10 @@ class Sac final : public Learner {
   double alpha() const;
   const SacConfig& config() const { return config_; }
   ActorCritic& networks() { return nets_; }
-  ReplayBuffer& replay() { return replay_; }
+  ReplayBuffer& replay() override { return replay_; }
 
  private:
+  void save_to(const std::string& path, bool with_replay) const;
   // Squashed Gaussian sample and its log-probability, from actor features.
   std::pair<torch::Tensor, torch::Tensor> sample_action(const torch::Tensor& actor_features);
   torch::Tensor standard_normal(std::int64_t rows, std::int64_t cols);

@@ -173,19 +173,21 @@ void Td3::update() {
   }
 }
 
-void Td3::save(const std::string& path) const {
-  torch::serialize::OutputArchive a, nets, target, actor_opt, critic_opt, replay;
+void Td3::save(const std::string& path) const { save_to(path, true); }
+void Td3::save_without_replay(const std::string& path) const { save_to(path, false); }
+
+void Td3::save_to(const std::string& path, bool with_replay) const {
+  torch::serialize::OutputArchive a, nets, target, actor_opt, critic_opt;
   write_common(a, counters_, rng_, "td3");
   nets_->save(nets);
   target_->save(target);
   actor_optimizer_->save(actor_opt);
   critic_optimizer_->save(critic_opt);
-  replay_.save(replay);
   a.write("networks", nets);
   a.write("target_networks", target);
   a.write("actor_optimizer", actor_opt);
   a.write("critic_optimizer", critic_opt);
-  a.write("replay", replay);
+  write_replay(a, replay_, with_replay);
   save_archive(a, path);
 }
 
@@ -194,7 +196,7 @@ void Td3::save_policy(const std::string& path) const {
 }
 
 void Td3::load(const std::string& path) {
-  torch::serialize::InputArchive a, nets, target, actor_opt, critic_opt, replay;
+  torch::serialize::InputArchive a, nets, target, actor_opt, critic_opt;
   a.load_from(path, device_);
   read_common(a, counters_, rng_, "td3");
   if (read_policy_only(a, "networks", *nets_)) return;
@@ -202,12 +204,11 @@ void Td3::load(const std::string& path) {
   a.read("target_networks", target);
   a.read("actor_optimizer", actor_opt);
   a.read("critic_optimizer", critic_opt);
-  a.read("replay", replay);
   nets_->load(nets);
   target_->load(target);
   actor_optimizer_->load(actor_opt);
   critic_optimizer_->load(critic_opt);
-  replay_.load(replay);
+  read_replay(a, replay_);
 }
 
 }  // namespace comorph::rl

@@ -68,6 +68,7 @@ class Td3 final : public Learner {
   int updates_due() const override;
   void update() override;
   void save(const std::string& path) const override;
+  void save_without_replay(const std::string& path) const override;
   void load(const std::string& path) override;
   void save_policy(const std::string& path) const override;
   const LearnerCounters& counters() const override { return counters_; }
@@ -78,9 +79,10 @@ class Td3 final : public Learner {
   const Td3Config& config() const { return config_; }
   ActorCritic& networks() { return nets_; }
   ActorCritic& target_networks() { return target_; }
-  ReplayBuffer& replay() { return replay_; }
+  ReplayBuffer& replay() override { return replay_; }
 
  private:
+  void save_to(const std::string& path, bool with_replay) const;
   torch::Tensor gaussian(std::int64_t rows, std::int64_t cols, double std);
 
   ObservationSpec spec_;

@@ -89,6 +89,31 @@ TEST(Checkpoint, AFlippedByteIsFoundAndThePreviousCheckpointIsUsed) {
   fs::remove_all(dir);
 }
 
+// The replay segments are files of the checkpoint like the others: a damaged
+// segment that only the newest checkpoint holds makes the reader fall back to
+// checkpoint.old; one that both share (hard links of one file) is named in
+// both, and nothing is loaded.
+TEST(Checkpoint, ADamagedReplaySegmentFallsBackOrIsNamedInBoth) {
+  const std::string dir = trained_run("segment");
+  std::vector<std::string> newest, shared;
+  for (const auto& e : fs::directory_iterator(dir + "/checkpoint")) {
+    const std::string name = e.path().filename().string();
+    if (name.find("-replay-") == std::string::npos) continue;
+    (fs::exists(dir + "/checkpoint.old/" + name) ? shared : newest).push_back(name);
+  }
+  ASSERT_FALSE(newest.empty());
+  ASSERT_FALSE(shared.empty());
+  flip_byte(dir + "/checkpoint/" + newest.front(), 100);
+  const CheckpointInfo info = read_checkpoint_info(dir);
+  EXPECT_EQ(info.directory, dir + "/checkpoint.old");
+  EXPECT_EQ(info.episodes, 2);
+  flip_byte(dir + "/checkpoint/" + shared.front(), 100);
+  const std::string e = error_of([&] { read_checkpoint_info(dir); });
+  EXPECT_NE(e.find(dir + "/checkpoint/"), std::string::npos) << e;
+  EXPECT_NE(e.find(dir + "/checkpoint.old/" + shared.front() + ": checksum mismatch"), std::string::npos) << e;
+  fs::remove_all(dir);
+}
+
 TEST(Checkpoint, ATorchLoadErrorIsOneLineNamingTheFile) {
   const std::string dir = trained_run("truncated");
   fs::remove_all(dir + "/checkpoint.old");
