@@ -58,8 +58,12 @@ ReplaySegments write_replay_segments(const ReplayBuffer& buffer, const std::stri
   const std::int64_t held_from = buffer.added() - buffer.size();
   // The previous segments are of this buffer's history only if it has not
   // gone back since (a resume always starts from the state they describe).
-  const bool continues = !previous.directory.empty() && previous.capacity == buffer.capacity() &&
-                         previous.added <= buffer.added();
+  // If one of their files has gone (a checkpoint directory removed by hand),
+  // the whole buffer is written again rather than the checkpoint failing.
+  bool continues = !previous.directory.empty() && previous.capacity == buffer.capacity() &&
+                   previous.added <= buffer.added();
+  for (const ReplaySegment& g : previous.segments)
+    continues = continues && fs::is_regular_file(fs::path(previous.directory) / g.file);
   std::int64_t new_from = held_from;
   if (continues) {
     for (const ReplaySegment& g : previous.segments) {

@@ -115,6 +115,17 @@ TEST(ReplaySegments, EachCheckpointWritesTheNewTransitionsAndReadsBackSlotForSlo
   const rl::ReplaySegments fourth = checkpoint(buffer, root + "/d", third, files);
   ASSERT_EQ(fourth.segments.size(), 1u);
   EXPECT_EQ(fourth.segments[0].file, third.segments[0].file);
+  // The previous checkpoint's files gone: the whole buffer is written again.
+  add(buffer, 13, 15);
+  fs::remove_all(root + "/d");
+  files.clear();
+  const rl::ReplaySegments fifth = checkpoint(buffer, root + "/e", fourth, files);
+  ASSERT_EQ(fifth.segments.size(), 1u);
+  EXPECT_EQ(fifth.segments[0].first, 10);
+  EXPECT_EQ(fifth.segments[0].count, 5);
+  rl::ReplayBuffer last = make_buffer();
+  rl::read_replay_segments(last, "motion", root + "/e");
+  expect_same(buffer, last);
   fs::remove_all(root);
 }
 
