@@ -366,6 +366,7 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
   log.stairs_climbed = env.stairs_climbed();
   log.action_saturation =
       m.steps > 0 ? static_cast<double>(saturated) / (static_cast<double>(m.steps) * control::kActionSize) : 0.0;
+  lap(kOther);
   return log;
 }
 
