@@ -1,11 +1,12 @@
-// The whole trainer's throughput for a preset (issue 10; docs/coopt.md,
-// "Throughput"), as ratios measured in one run:
+// The whole trainer's throughput for a preset (docs/coopt.md, "Throughput"),
+// as ratios measured in one run:
 //   - the trainer's control steps/s over --steps control steps (whole
 //     episodes, the run's own seeds, writing episodes.csv as `comorph train`
 //     does, ending with a checkpoint as an interrupted run does);
 //   - each side alone on the same preset (coopt::measure_side_rates): the
 //     acting side (env, acting copy, pilot, scene source, DQN) and the motion
-//     learner (store + updates); bound fraction = trainer / the slower side;
+//     learner (store + updates); bound fraction = trainer / the slower side
+//     (without a learner thread: / the rate of both sides one after the other);
 //   - each thread's share of the trainer's wall time (coopt::TrainerTiming);
 //   - the checkpoint: s for one with a full motion replay, s for the next one
 //     after checkpoint_interval episodes of new transitions, and that next
@@ -112,7 +113,11 @@ int main(int argc, char** argv) {
 
     // 2. Each side alone.
     const coopt::SideRates sides = coopt::measure_side_rates(config, steps);
-    const double bound = std::min(sides.acting_steps_per_s, sides.learner_steps_per_s);
+    // Two threads run at the slower side's rate at best; one thread (no
+    // learner thread) does both sides' work one after the other.
+    const double bound = config.trainer.learner_thread
+                             ? std::min(sides.acting_steps_per_s, sides.learner_steps_per_s)
+                             : 1.0 / (1.0 / sides.acting_steps_per_s + 1.0 / sides.learner_steps_per_s);
 
     // 3. Checkpoints: one with the motion replay full, then one after
     //    checkpoint_interval episodes of the trainer's mean length.
@@ -163,7 +168,8 @@ int main(int argc, char** argv) {
                sides.acting_steps_per_s, sides.acting_steps);
     fmt::print("learner alone       {:8.0f} control steps/s ({} steps after learning_starts: store + updates)\n",
                sides.learner_steps_per_s, sides.learner_steps);
-    fmt::print("bound fraction      {:8.2f} (trainer / the slower side)\n", steps_per_s / bound);
+    fmt::print("bound fraction      {:8.2f} (trainer / {})\n", steps_per_s / bound,
+               config.trainer.learner_thread ? "the slower side" : "both sides one after the other");
     fmt::print("share of the trainer's wall time:\n");
     for (const auto& [key, value] : out["share"].items()) fmt::print("  {:<16} {:6.3f}\n", key, value.get<double>());
     if (!skip_checkpoint)
