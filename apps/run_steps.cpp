@@ -307,8 +307,8 @@ std::uintmax_t export_run(const std::string& run_dir, const std::string& out) {
     const fs::path to = fs::path(out) / name;
     if (name == "episodes.csv") {
       // Thousands of rows of 17-digit numbers: rounded to what the report
-      // shows (1 ms, 0.1 J, 1e-4), the training log of a 4300-episode run
-      // fits beside its networks in 2 MB.
+      // shows (1 ms, 0.1 J, 0.1 of R1, 1e-4), the training log of a
+      // 4300-episode run fits beside its networks in 2 MB.
       auto records = comorph::report::read_episodes_csv(e.path().string());
       // v rounded to 1 / per_unit: dividing by a whole number gives the double
       // nearest the decimal, which the CSV writer prints in its few digits.
@@ -317,7 +317,7 @@ std::uintmax_t export_run(const std::string& run_dir, const std::string& out) {
         r.time_s = round_to(r.time_s, 1e3);
         r.energy_J = round_to(r.energy_J, 10);
         r.distance_fraction = round_to(r.distance_fraction, 1e4);
-        r.return_R1 = round_to(r.return_R1, 100);
+        r.return_R1 = round_to(r.return_R1, 10);
         r.action_saturation = round_to(r.action_saturation, 1e4);
       }
       comorph::report::write_episodes_csv(to.string(), records);
