@@ -22,8 +22,13 @@ void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 using namespace comorph;
 
-TEST(HotPath, StepDoesNotAllocate) {
-  const task::EnvConfig c;
+// Parametrized on the obstacle scan: with scan_columns > 0 the clearance row
+// is cast every step, into the buffer sized at construction.
+class HotPath : public ::testing::TestWithParam<int> {};
+
+TEST_P(HotPath, StepDoesNotAllocate) {
+  task::EnvConfig c;
+  c.robot.scan_columns = GetParam();
   const long at_start = g_allocations.load();
   task::MultiTaskEnv env(c);
   EXPECT_GT(g_allocations.load(), at_start);  // the counter sees the library's allocations
@@ -48,3 +53,5 @@ TEST(HotPath, StepDoesNotAllocate) {
   EXPECT_EQ(g_allocations.load() - after_reset, 0);
   EXPECT_EQ(env.world().compilations(), 1);
 }
+
+INSTANTIATE_TEST_SUITE_P(ScanColumns, HotPath, ::testing::Values(0, 24));
