@@ -61,6 +61,20 @@ void expect_same(const rl::ReplayBuffer& a, const rl::ReplayBuffer& b) {
   EXPECT_TRUE(torch::equal(x.has_target, y.has_target));
 }
 
+// Reading `dir` back into a fresh buffer gives `buffer` slot for slot.
+void expect_reads_back(const rl::ReplayBuffer& buffer, const std::string& dir) {
+  rl::ReplayBuffer restored = make_buffer();
+  rl::read_replay_segments(restored, "motion", dir);
+  expect_same(buffer, restored);
+}
+
+// `s` is one segment of transitions [first, first + count).
+void expect_one_segment(const rl::ReplaySegments& s, std::int64_t first, std::int64_t count) {
+  ASSERT_EQ(s.segments.size(), 1u);
+  EXPECT_EQ(s.segments[0].first, first);
+  EXPECT_EQ(s.segments[0].count, count);
+}
+
 // One checkpoint of `buffer` into a fresh directory `dir`.
 rl::ReplaySegments checkpoint(const rl::ReplayBuffer& buffer, const std::string& dir,
                               const rl::ReplaySegments& previous, std::vector<std::string>& files) {
@@ -77,9 +91,7 @@ TEST(ReplaySegments, EachCheckpointWritesTheNewTransitionsAndReadsBackSlotForSlo
   add(buffer, 0, 3);
   std::vector<std::string> files;
   const rl::ReplaySegments first = checkpoint(buffer, root + "/a", {}, files);
-  ASSERT_EQ(first.segments.size(), 1u);
-  EXPECT_EQ(first.segments[0].first, 0);
-  EXPECT_EQ(first.segments[0].count, 3);
+  expect_one_segment(first, 0, 3);
   EXPECT_EQ(files, (std::vector<std::string>{"motion-replay-000000000000.pt", "motion-replay.yaml"}));
 
   // 4 more (7 added, slots hold 2..6): the first segment still holds 2, so it
@@ -104,12 +116,8 @@ TEST(ReplaySegments, EachCheckpointWritesTheNewTransitionsAndReadsBackSlotForSlo
   add(buffer, 7, 13);
   files.clear();
   const rl::ReplaySegments third = checkpoint(buffer, root + "/c", read, files);
-  ASSERT_EQ(third.segments.size(), 1u);
-  EXPECT_EQ(third.segments[0].first, 8);
-  EXPECT_EQ(third.segments[0].count, 5);
-  rl::ReplayBuffer again = make_buffer();
-  rl::read_replay_segments(again, "motion", root + "/c");
-  expect_same(buffer, again);
+  expect_one_segment(third, 8, 5);
+  expect_reads_back(buffer, root + "/c");
   // Nothing new: no new segment, the same index.
   files.clear();
   const rl::ReplaySegments fourth = checkpoint(buffer, root + "/d", third, files);
@@ -120,12 +128,8 @@ TEST(ReplaySegments, EachCheckpointWritesTheNewTransitionsAndReadsBackSlotForSlo
   fs::remove_all(root + "/d");
   files.clear();
   const rl::ReplaySegments fifth = checkpoint(buffer, root + "/e", fourth, files);
-  ASSERT_EQ(fifth.segments.size(), 1u);
-  EXPECT_EQ(fifth.segments[0].first, 10);
-  EXPECT_EQ(fifth.segments[0].count, 5);
-  rl::ReplayBuffer last = make_buffer();
-  rl::read_replay_segments(last, "motion", root + "/e");
-  expect_same(buffer, last);
+  expect_one_segment(fifth, 10, 5);
+  expect_reads_back(buffer, root + "/e");
   fs::remove_all(root);
 }
 
