@@ -116,7 +116,7 @@ void ScriptedPilot::act(const MultiTaskEnv& env, float a[control::kActionSize],
   a[1] = float(std::clamp(p_.heading_gain * error, -1.0, 1.0));
   if (climbing) {
     const int n = env.world().modules();
-    const StairGait& g = p_.use_gait_by_modules[std::size_t(n)] ? p_.gait_by_modules[std::size_t(n)] : p_.gait;
+    const StairGait& g = p_.gait_by_modules[std::size_t(n)].value_or(p_.gait);
     a[0] = g.speed;
     a[2] = g.amp_front;
     a[3] = g.phase;
@@ -130,21 +130,16 @@ void ScriptedPilot::act(const MultiTaskEnv& env, float a[control::kActionSize],
   }
 }
 
-}  // namespace comorph::task
-
-namespace comorph::task {
-
 PilotParams searched_stair_gaits() {
   // A search over a0 in {1, 0.6} x a2 = a4 in {1, 0} x a3 in {-0.5, -0.2, 0.2, 0.5}
   // for 3, 4, 5, 7 and 9 modules (3 seeds per height), beside the physics table's
   // even lengths: full amplitude with wave lag -0.5 is the best (or as good as any)
   // everywhere but at 3 modules, which it stalls on the first riser (0 of 3 at
   // 0.04 m), where lag +0.2 climbs 3 of 3. 7 modules climb 0.08 m with no gait of
-  // the grid, and 3 modules never climb 0.06 m.
+  // the grid, and 3 modules never climb 0.06 m (without noise on the gait).
   PilotParams p;
   p.gait = {1.0f, 1.0f, -0.5f, 1.0f};
-  p.gait_by_modules[3] = {1.0f, 1.0f, 0.2f, 1.0f};
-  p.use_gait_by_modules[3] = true;
+  p.gait_by_modules[3] = StairGait{1.0f, 1.0f, 0.2f, 1.0f};
   return p;
 }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <vector>
 
 #include "control/motion_modes.hpp"
@@ -22,20 +23,18 @@ struct StairGait {  // stair-mode action (Eq. 4/5 inputs), held while climbing
 
 struct PilotParams {
   StairGait gait;               // used in stair mode (unless gait_by_modules has one for the chain)
-  // Per chain length (index = modules): its own stair gait where use[n] is set.
-  // One gait does not suit every length: the wave lag that climbs with 2, 4 or
-  // 6 modules stalls 3 modules on the first riser (searched_stair_gaits()).
-  std::array<StairGait, 11> gait_by_modules{};
-  std::array<bool, 11> use_gait_by_modules{};
+  // Per chain length (index = modules), a gait of its own where set. One gait
+  // does not suit every length: the wave lag that climbs with 2, 4 or 6
+  // modules stalls 3 modules on the first riser (searched_stair_gaits()).
+  std::array<std::optional<StairGait>, sim::kMaxChain + 1> gait_by_modules{};
   double heading_gain = 2.5;    // a1 per rad of heading error
   double lookahead = 0.6;       // m along the planned path
   double clearance = 0.40;      // m, obstacles inflated by this when planning
   double slow_turn_error = 0.6; // rad: above this heading error the robot turns before driving
 };
 
-// The stair gait of every chain length from a search over a0 x a2=a4 x a3 on
-// held-out seeds (docs/sim.md, "One gait per chain length"): PilotParams with
-// gait_by_modules filled in for 2..10 modules.
+// The pilot with the stair gaits of a search over a0 x a2=a4 x a3 per chain
+// length (docs/results.md): the shared gait, and 3 modules' own.
 PilotParams searched_stair_gaits();
 
 class ScriptedPilot {

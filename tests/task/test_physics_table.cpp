@@ -52,9 +52,9 @@ TEST(PhysicsTable, ThreeModulesNeedTheirOwnGait) {
   const task::EnvConfig c;
   const task::PhysicsTableOptions o;
   const task::PilotParams p = task::searched_stair_gaits();
-  ASSERT_TRUE(p.use_gait_by_modules[3]);
+  ASSERT_TRUE(p.gait_by_modules[3].has_value());
   for (std::uint64_t seed : {1, 2}) {
     EXPECT_FALSE(task::run_climb_trial(c, 3, 0.04, seed, kWave, o).climbed) << seed;
-    EXPECT_TRUE(task::run_climb_trial(c, 3, 0.04, seed, p.gait_by_modules[3], o).climbed) << seed;
+    EXPECT_TRUE(task::run_climb_trial(c, 3, 0.04, seed, *p.gait_by_modules[3], o).climbed) << seed;
   }
 }
