@@ -97,6 +97,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
               "learner_thread", "torch_threads", "motion_image", "config_vector", "scene_source",
               "motion_clearance", "normalize_state", "decision_camera", "warmup_policy", "warmup_noise",
               "scripted_interval", "pilot_random_configs", "pilot_gait_per_modules", "pilot_labels",
+              "config_learns_from_pilot",
               "classifier_dir", "scenario", "stair_height", "eval_interval", "eval_episodes", "eval_seed",
               "checkpoint_interval", "progress_interval", "env_dir"});
   if (!n || n.IsNull()) return p;
@@ -128,6 +129,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   f.add(pre + ".pilot_random_configs", &p.pilot_random_configs);
   f.add(pre + ".pilot_gait_per_modules", &p.pilot_gait_per_modules);
   f.add(pre + ".pilot_labels", &p.pilot_labels);
+  f.add(pre + ".config_learns_from_pilot", &p.config_learns_from_pilot);
   f.add(pre + ".stair_height", &p.stair_height, 0, 0.5);
   f.add(pre + ".eval_interval", &p.eval_interval, 0, 10000000);
   f.add(pre + ".eval_episodes", &p.eval_episodes, 1, 100000);

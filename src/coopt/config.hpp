@@ -62,6 +62,11 @@ struct TrainerParams {
   // The pilot climbs with each chain length's own searched gait
   // (task::searched_stair_gaits); false: one gait (a0, a2, a3, a4) = (1, 1, -0.5, 1) for all.
   bool pilot_gait_per_modules = false;
+  // The DQN also learns from the episodes the pilot drives (warm-up and every
+  // scripted_interval-th). false: only from the motion model's own episodes,
+  // so its values say what the motion model achieves with each chain, not what
+  // the pilot does (the pilot climbs with chains the model cannot drive yet).
+  bool config_learns_from_pilot = true;
   // Every training transition carries the pilot's action for its state as a
   // behaviour-cloning target (td3.bc_weight), also where the motion model drove:
   // the pilot labels the states the learner visits (DAgger, Ross et al. 2011).

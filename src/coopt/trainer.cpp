@@ -728,8 +728,12 @@ struct Trainer::Impl {
       ++steps;
       if (!record && filled == config.trainer.sync_interval) hand_over();
     };
-    hooks.config = [this](const rl::Observation& o, const rl::Action& a, float r2, const rl::Observation& n,
-                          bool term, bool trunc, int k) {
+    const bool scripted = t.warmup_policy == "scripted" &&
+                          (warmup || (t.scripted_interval > 0 && episode % t.scripted_interval == 0));
+    const bool config_learns = !scripted || t.config_learns_from_pilot;
+    hooks.config = [this, config_learns](const rl::Observation& o, const rl::Action& a, float r2,
+                                         const rl::Observation& n, bool term, bool trunc, int k) {
+      if (!config_learns) return;
       agent.config->store(o, a, r2, n, term, trunc, k);
       for (int u = agent.config->updates_due(); u > 0; --u) agent.config->update();
       if (callbacks.on_decision) {
@@ -746,8 +750,6 @@ struct Trainer::Impl {
         callbacks.on_decision(d);
       }
     };
-    const bool scripted = t.warmup_policy == "scripted" &&
-                          (warmup || (t.scripted_interval > 0 && episode % t.scripted_interval == 0));
     if (warmup || (scripted && t.pilot_random_configs))
       hooks.random_config = [this](const std::vector<std::uint8_t>& mask) {
         int valid = 0;

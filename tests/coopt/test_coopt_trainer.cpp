@@ -166,6 +166,26 @@ TEST(Trainer, ScriptedWarmupDrivesTowardsTheGoal) {
   fs::remove_all(b);
 }
 
+// trainer.config_learns_from_pilot=false: the DQN stores (and reports) no
+// transition of the pilot's episodes (the 2 warm-up ones, then every 2nd), and
+// one or more of each of the motion model's; true: of every episode.
+TEST(Trainer, ConfigModelCanLearnOnlyFromTheMotionModelsEpisodes) {
+  const std::string a = temp_dir("dqn_all"), b = temp_dir("dqn_own");
+  std::vector<std::string> all = kWithDemonstrations, own = kWithDemonstrations;
+  all.push_back("trainer.config_learns_from_pilot=true");
+  own.push_back("trainer.config_learns_from_pilot=false");
+  const auto episodes_with_decisions = [](const RunResult& r) {
+    std::vector<int> e;
+    for (const auto& d : r.decisions)
+      if (e.empty() || e.back() != d.episode) e.push_back(d.episode);
+    return e;
+  };
+  EXPECT_EQ(episodes_with_decisions(run_ci(all, a)), (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(episodes_with_decisions(run_ci(own, b)), (std::vector<int>{3, 5}));
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
 TEST(Trainer, ResumeAfterInterruptionContinuesTheSameEpisodesWithIdenticalResults) {
   const std::vector<std::string> sets{"trainer.episodes=6", "trainer.checkpoint_interval=3"};
   const std::string full_dir = temp_dir("full");
