@@ -21,6 +21,17 @@ const char* termination_name(Termination t) {
   return "?";
 }
 
+EnvSpec MultiTaskEnv::spec(const EnvConfig& config) {
+  const sim::RobotParams& r = config.robot;
+  EnvSpec s;
+  s.depth_height = r.depth_height;
+  s.depth_width = r.depth_width;
+  s.clearance_size = clearance_width(r);
+  s.decision_depth_height = r.decision_depth_height;
+  s.decision_depth_width = r.decision_depth_width;
+  return s;
+}
+
 MultiTaskEnv::MultiTaskEnv(const EnvConfig& config, std::shared_ptr<sim::ModelCache> cache)
     : config_(config), world_(config.robot, config.scene, std::move(cache)) {
   const sim::RobotParams& r = config_.robot;

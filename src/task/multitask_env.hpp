@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "control/motion_modes.hpp"
+#include "morphology/configuration.hpp"
 #include "sim/scene.hpp"
 #include "sim/world.hpp"
 #include "task/env_config.hpp"
@@ -80,8 +81,30 @@ inline constexpr int kMode = 45;         // 1: motion mode of the last step (0 f
 inline constexpr int kStateSize = 46;
 }  // namespace obs
 
+// What the env observes and takes: shapes and bounds, declared here so that
+// learners and bindings read them instead of assembling them.
+struct EnvSpec {
+  int depth_channels = 1;  // depth(): depth_channels x depth_height x depth_width, row-major
+  int depth_height = 0;
+  int depth_width = 0;
+  float depth_low = 0.01f;  // depth() and clearance(): fraction of the sensor's range
+  float depth_high = 1.0f;
+  int state_size = obs::kStateSize;  // state(): unbounded (m, m/s, R1; layout in task::obs)
+  int clearance_size = 0;            // clearance()
+  int decision_depth_height = 0;     // render_decision_depth(): height x width
+  int decision_depth_width = 0;
+  int action_size = control::kActionSize;  // step(): action_size floats in [action_low, action_high]
+  float action_low = -1.0f;
+  float action_high = 1.0f;
+  int min_modules = kMinModules;     // EpisodeSpec::modules and reconfigure() range
+  int max_modules = kMaxModules;
+};
+
 class MultiTaskEnv {
  public:
+  static EnvSpec spec(const EnvConfig& config);
+  EnvSpec spec() const { return spec(config_); }
+
   explicit MultiTaskEnv(const EnvConfig& config, std::shared_ptr<sim::ModelCache> cache = nullptr);
 
   // New episode; observations are valid after it.

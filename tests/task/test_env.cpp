@@ -91,6 +91,36 @@ TEST(Env, ObservationLayout) {
   }
 }
 
+// The declared spec sizes every observation buffer and bounds its values.
+TEST(Env, SpecDeclaresTheObservationsAndTheAction) {
+  for (int scan : {0, 24}) {
+    task::EnvConfig c;
+    c.robot.scan_columns = scan;
+    task::MultiTaskEnv env(c);
+    const task::EnvSpec s = env.spec();
+    EXPECT_EQ(s.depth_channels * s.depth_height * s.depth_width, env.depth_width() * env.depth_height());
+    EXPECT_EQ(s.state_size, task::obs::kStateSize);
+    EXPECT_EQ(s.clearance_size, scan > 0 ? scan : c.robot.depth_width);
+    EXPECT_EQ(s.clearance_size, env.clearance_width());
+    EXPECT_EQ(s.decision_depth_width * s.decision_depth_height,
+              env.decision_depth_width() * env.decision_depth_height());
+    EXPECT_EQ(s.action_size, control::kActionSize);
+    EXPECT_EQ(s.min_modules, 2);
+    EXPECT_EQ(s.max_modules, 10);
+    env.reset(spec(3, 5));
+    const float a[5] = {1.0f, 0.5f, 0.0f, 0.0f, 0.0f};
+    for (int t = 0; t < 20; ++t) env.step(a);
+    for (int i = 0; i < s.depth_height * s.depth_width; ++i) {
+      EXPECT_GE(env.depth()[i], s.depth_low);
+      EXPECT_LE(env.depth()[i], s.depth_high);
+    }
+    for (int i = 0; i < s.clearance_size; ++i) {
+      EXPECT_GE(env.clearance()[i], s.depth_low);
+      EXPECT_LE(env.clearance()[i], s.depth_high);
+    }
+  }
+}
+
 TEST(Env, ScriptedRunClimbsReachesTheTargetAndReportsEvents) {
   const task::EnvConfig c;
   task::MultiTaskEnv env(c);
