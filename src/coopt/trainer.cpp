@@ -198,10 +198,12 @@ float state_scale(int i) {
   return 1.0f;
 }
 
-// The motion model's vector: the state (scaled if asked), then the clearance row if asked.
-void fill_motion(const task::MultiTaskEnv& env, const TrainerParams& t, rl::Observation& o) {
-  if (t.motion_image) std::copy(env.depth(), env.depth() + o.image.size(), o.image.begin());
-  const float* state = env.state();
+// The motion model's input from the env's observation (depth(), state(),
+// clearance()): the image if asked, the state (scaled if asked), then the
+// clearance row if asked.
+void fill_motion(const float* depth, const float* state, const float* clearance, const TrainerParams& t,
+                 rl::Observation& o) {
+  if (t.motion_image) std::copy(depth, depth + o.image.size(), o.image.begin());
   for (int i = 0; i < task::obs::kStateSize; ++i) {
     float v = state[i];
     if (t.normalize_state) {
@@ -211,22 +213,31 @@ void fill_motion(const task::MultiTaskEnv& env, const TrainerParams& t, rl::Obse
     o.vector[static_cast<std::size_t>(i)] = v;
   }
   if (t.motion_clearance)
-    std::copy(env.clearance(), env.clearance() + env.clearance_width(), o.vector.begin() + task::obs::kStateSize);
+    std::copy(clearance, clearance + (o.vector.size() - task::obs::kStateSize), o.vector.begin() + task::obs::kStateSize);
 }
 
-void fill_config(const task::MultiTaskEnv& env, const TrainerParams& t, int max_modules, int scene, Buffers& b,
-                 rl::Observation& o) {
+void fill_motion(const task::MultiTaskEnv& env, const TrainerParams& t, rl::Observation& o) {
+  fill_motion(env.depth(), env.state(), env.clearance(), t, o);
+}
+
+// The configuration model's vector [C_n / 10, scene one-hot] and mask; the image is already in o.image.
+void fill_config_vector(const TrainerParams& t, int max_modules, int scene, Buffers& b, rl::Observation& o) {
   const bool vector = t.config_vector;
-  if (t.decision_camera)
-    env.render_decision_depth(o.image.data());
-  else
-    std::copy(env.depth(), env.depth() + o.image.size(), o.image.begin());
   if (vector) {
     o.vector[0] = static_cast<float>(max_modules) / kMaxModules;
     for (int k = 0; k < 3; ++k) o.vector[1 + k] = scene == k ? 1.0f : 0.0f;
   }
   candidate_mask(max_modules, b.mask);
   o.valid_actions = b.mask;
+}
+
+void fill_config(const task::MultiTaskEnv& env, const TrainerParams& t, int max_modules, int scene, Buffers& b,
+                 rl::Observation& o) {
+  if (t.decision_camera)
+    env.render_decision_depth(o.image.data());
+  else
+    std::copy(env.depth(), env.depth() + o.image.size(), o.image.begin());
+  fill_config_vector(t, max_modules, scene, b, o);
 }
 
 control::MotionMode mode_of(int scene) {
@@ -1083,6 +1094,14 @@ CheckpointInfo open_checkpoint_for_evaluation(const CooptConfig& config, const s
   return info;
 }
 
+// Both networks of a trained run's checkpoint, for greedy acting.
+void load_greedy_agent(const CooptConfig& c, const CheckpointInfo& checkpoint, Agent& agent) {
+  agent.motion = make_motion(c, 1, true);
+  load_checkpoint_file(*agent.motion, (fs::path(checkpoint.directory) / "motion_actor.pt").string());
+  agent.config = make_config_model(c, 2);
+  if (agent.config) load_checkpoint_file(*agent.config, (fs::path(checkpoint.directory) / "config_model.pt").string());
+}
+
 // Greedy episodes of a trained run: one env, scene source and copy of both
 // networks (loaded from the checkpoint); one per evaluation thread.
 struct GreedyPlayer {
@@ -1093,10 +1112,7 @@ struct GreedyPlayer {
   Buffers buffers;
 
   GreedyPlayer(const CooptConfig& c, const CheckpointInfo& checkpoint) : config(c), env(c.env), scene(c) {
-    agent.motion = make_motion(c, 1, true);
-    load_checkpoint_file(*agent.motion, (fs::path(checkpoint.directory) / "motion_actor.pt").string());
-    agent.config = make_config_model(c, 2);
-    if (agent.config) load_checkpoint_file(*agent.config, (fs::path(checkpoint.directory) / "config_model.pt").string());
+    load_greedy_agent(c, checkpoint, agent);
     allocate_buffers(c, buffers);
   }
 
@@ -1171,6 +1187,44 @@ EpisodeLog play_evaluation_episode(const CooptConfig& config, const std::string&
                                      static_cast<std::uint64_t>(request.first_seed) + request.index, request.index);
   if (request.stair_height_m > 0) spec.stair_height = request.stair_height_m;
   return player.play_episode(request.scenario, spec, request.index, observer ? &observer : nullptr);
+}
+
+struct GreedyPolicy::Impl {
+  CooptConfig config;
+  Agent agent;
+  Buffers buffers;
+};
+
+GreedyPolicy::GreedyPolicy(const CooptConfig& config, const std::string& run_dir) : impl_(std::make_unique<Impl>()) {
+  impl_->config = config;
+  load_greedy_agent(config, open_checkpoint_for_evaluation(config, run_dir), impl_->agent);
+  allocate_buffers(config, impl_->buffers);
+}
+
+GreedyPolicy::~GreedyPolicy() = default;
+
+bool GreedyPolicy::hierarchical() const { return impl_->agent.config != nullptr; }
+
+int GreedyPolicy::decision_image_size() const { return config_spec(impl_->config).image_size(); }
+
+int GreedyPolicy::choose_modules(const float* image, int max_modules, int scene) {
+  if (!impl_->agent.config) throw std::logic_error("GreedyPolicy::choose_modules: the run has no configuration model");
+  if (max_modules < kMinModules || max_modules > kMaxModules)
+    throw std::invalid_argument("max_modules must be in " + std::to_string(kMinModules) + ".." +
+                                std::to_string(kMaxModules) + ", got " + std::to_string(max_modules));
+  if (scene < 0 || scene > 2) throw std::invalid_argument("scene must be 0, 1 or 2, got " + std::to_string(scene));
+  Buffers& b = impl_->buffers;
+  std::copy(image, image + b.cobs.image.size(), b.cobs.image.begin());
+  fill_config_vector(impl_->config.trainer, max_modules, scene, b, b.cobs);
+  impl_->agent.config->act(b.cobs, false, b.caction);
+  return modules_of(b.caction.discrete);
+}
+
+void GreedyPolicy::act(const float* depth, const float* state, const float* clearance, float* action) {
+  Buffers& b = impl_->buffers;
+  fill_motion(depth, state, clearance, impl_->config.trainer, b.obs);
+  impl_->agent.motion->act(b.obs, false, b.action);
+  std::copy(b.action.continuous.begin(), b.action.continuous.end(), action);
 }
 
 }  // namespace comorph::coopt

@@ -222,4 +222,27 @@ struct EvalEpisodeRequest {
 EpisodeLog play_evaluation_episode(const CooptConfig& config, const std::string& run_dir,
                                    const EvalEpisodeRequest& request, const StepObserver& observer);
 
+// A trained run's acting networks, one observation at a time (the Python
+// binding's load_run): loaded from run_dir/checkpoint as evaluate() loads
+// them, acting greedily on the inputs play() builds from the env.
+class GreedyPolicy {
+ public:
+  GreedyPolicy(const CooptConfig& config, const std::string& run_dir);
+  ~GreedyPolicy();
+  bool hierarchical() const;  // has a configuration model
+  // Floats of the configuration model's image: the decision camera's
+  // (MultiTaskEnv::render_decision_depth) with trainer.decision_camera, else depth().
+  int decision_image_size() const;
+  // The configuration model's greedy choice of modules in [2, max_modules]
+  // for that image, the largest allowed chain C_n and the scene (sim::SceneLabel).
+  int choose_modules(const float* image, int max_modules, int scene);
+  // The motion model's greedy action (control::kActionSize floats) for the
+  // env's depth(), state() and clearance().
+  void act(const float* depth, const float* state, const float* clearance, float* action);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 }  // namespace comorph::coopt
