@@ -13,6 +13,8 @@ packages=(
   libegl-dev libegl-mesa0 libgl1-mesa-dri libgl-dev # headless rendering
   libopengl-dev                                     # libOpenGL.so: GL without GLX, for EGL (report)
   ffmpeg gnuplot-nox                                # video, plots
+  pybind11-dev python3-dev python3-numpy python3-pytest  # the Python module and its tests (docs/python.md)
+  python3-torch                                     # examples/train_reinforce.py (its test skips without it)
 )
 
 sudo_cmd=()
