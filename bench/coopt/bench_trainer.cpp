@@ -124,8 +124,8 @@ int main(int argc, char** argv) {
     const int interval = config.trainer.checkpoint_interval;
     const double steps_per_episode = static_cast<double>(trainer_steps) / episodes;
     const double episode_s = (timing.wall_s - timing.checkpoint_s) / episodes;
-    const std::string& motion_yaml = config.trainer.motion_algo == "sac" ? config.sac_yaml : config.td3_yaml;
-    const std::int64_t replay = YAML::Load(motion_yaml)["buffer_size"].as<std::int64_t>();
+    const std::int64_t replay =
+        config.trainer.motion_algo == "sac" ? config.sac.buffer_size : config.td3.buffer_size;
     const auto new_transitions = static_cast<std::int64_t>(interval * steps_per_episode);
     coopt::CheckpointCost cost;
     if (!skip_checkpoint) {

@@ -3,9 +3,6 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "rl/dqn.hpp"
-#include "rl/sac.hpp"
-#include "rl/td3.hpp"
 #include "sim/params.hpp"
 #include "common/yaml_fields.hpp"
 
@@ -233,16 +230,14 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
   };
   require_section(c.trainer.motion_algo, "trainer.motion_algo " + c.trainer.motion_algo, "motion model");
   if (c.trainer.mode == "hierarchical") require_section("dqn", "trainer.mode hierarchical", "configuration model");
-  c.td3_yaml = dump(root["td3"]);
-  c.sac_yaml = dump(root["sac"]);
-  c.dqn_yaml = dump(root["dqn"]);
-  const rl::Td3Config td3 = rl::Td3Config::from_yaml(YAML::Load(c.td3_yaml), src + ": td3");
-  const rl::SacConfig sac = rl::SacConfig::from_yaml(YAML::Load(c.sac_yaml), src + ": sac");
-  rl::DqnConfig::from_yaml(YAML::Load(c.dqn_yaml), src + ": dqn");
-  if (!c.td3_yaml.empty() && (td3.random_action_episodes != 0 || td3.random_action_steps != 0))
+  const auto given = [&](const char* name) { return root[name] && !root[name].IsNull(); };
+  c.td3 = rl::Td3Config::from_yaml(root["td3"], src + ": td3");
+  c.sac = rl::SacConfig::from_yaml(root["sac"], src + ": sac");
+  c.dqn = rl::DqnConfig::from_yaml(root["dqn"], src + ": dqn");
+  if (given("td3") && (c.td3.random_action_episodes != 0 || c.td3.random_action_steps != 0))
     throw std::runtime_error(src + ": field 'td3.random_action_episodes/steps': must be 0, "
                                    "the warm-up is trainer.warmup_episodes (both models)");
-  if (!c.sac_yaml.empty() && (sac.random_action_episodes != 0 || sac.random_action_steps != 0))
+  if (given("sac") && (c.sac.random_action_episodes != 0 || c.sac.random_action_steps != 0))
     throw std::runtime_error(src + ": field 'sac.random_action_episodes/steps': must be 0, "
                                    "the warm-up is trainer.warmup_episodes (both models)");
   c.text = dump(root);

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "perception/perception_config.hpp"
+#include "rl/learner_params.hpp"
 #include "task/env_config.hpp"
 
 namespace comorph::coopt {
@@ -95,8 +96,11 @@ struct CooptConfig {
   EvalParams eval;
   task::EnvConfig env;                         // configs/sim + the env: overrides
   perception::PerceptionConfig perception;     // classifier + switch detector
-  // The learner sections, validated here and parsed again by the torch side.
-  std::string td3_yaml, sac_yaml, dqn_yaml;
+  // The learners' hyperparameters (the td3:, sac: and dqn: sections; a
+  // section the run does not use may be absent and keeps the defaults).
+  rl::Td3Config td3;
+  rl::SacConfig sac;
+  rl::DqnConfig dqn;
   // The merged YAML (file + --set): what the run directory's config.yaml holds
   // and what a checkpoint is compared against.
   std::string text;

@@ -89,12 +89,12 @@ rl::ObservationSpec config_spec(const CooptConfig& c) {
 std::unique_ptr<rl::Learner> make_motion(const CooptConfig& c, std::uint64_t seed, bool replica) {
   const rl::ObservationSpec spec = motion_spec(c);
   if (c.trainer.motion_algo == "sac") {
-    rl::SacConfig cfg = rl::SacConfig::from_yaml(YAML::Load(c.sac_yaml), "sac");
+    rl::SacConfig cfg = c.sac;
     cfg.random_action_episodes = c.trainer.warmup_episodes;
     if (replica) cfg.buffer_size = 1;
     return std::make_unique<rl::Sac>(spec, control::kActionSize, cfg, seed);
   }
-  rl::Td3Config cfg = rl::Td3Config::from_yaml(YAML::Load(c.td3_yaml), "td3");
+  rl::Td3Config cfg = c.td3;
   cfg.random_action_episodes = c.trainer.warmup_episodes;
   if (replica) cfg.buffer_size = 1;
   return std::make_unique<rl::Td3>(spec, control::kActionSize, cfg, seed);
@@ -108,8 +108,7 @@ rl::ActorCritic& networks_of(rl::Learner& l) {
 
 std::unique_ptr<rl::Dqn> make_config_model(const CooptConfig& c, std::uint64_t seed) {
   if (c.trainer.mode != "hierarchical") return nullptr;
-  const rl::DqnConfig cfg = rl::DqnConfig::from_yaml(YAML::Load(c.dqn_yaml), "dqn");
-  return std::make_unique<rl::Dqn>(config_spec(c), kCandidates, cfg, seed);
+  return std::make_unique<rl::Dqn>(config_spec(c), kCandidates, c.dqn, seed);
 }
 
 // ---------------------------------------------------------------------------

@@ -5,31 +5,6 @@
 
 namespace comorph::rl {
 
-DqnConfig DqnConfig::from_yaml(const YAML::Node& node, const std::string& source) {
-  DqnConfig c;
-  YamlFields f(source);
-  add_shared_learner_fields(f, c);
-  f.add("learning_rate", &c.learning_rate, kMinPositive, 1.0);
-  f.add("adam_epsilon", &c.adam_epsilon, 1e-20, 1.0);
-  f.add("target_update_interval", &c.target_update_interval, 1, 1000000000);
-  f.add("epsilon_start", &c.epsilon_start, 0.0, 1.0);
-  f.add("epsilon_end", &c.epsilon_end, 0.0, 1.0);
-  f.add("epsilon_decay", &c.epsilon_decay, 0.0, 1e12);
-  f.add("loss", &c.loss);
-  f.add("double_dqn", &c.double_dqn);
-  f.apply(node);
-  check_hidden_sizes(f, c);
-  if (c.loss != "huber" && c.loss != "mse")
-    throw std::invalid_argument(source + ": field \"loss\" must be huber or mse, got \"" + c.loss + "\"");
-  if (c.batch_size <= 0 || c.buffer_size <= 0 || c.train_frequency <= 0 ||
-      c.target_update_interval <= 0)
-    throw std::invalid_argument(source + ": batch_size, buffer_size, train_frequency and "
-                                         "target_update_interval must be > 0");
-  check_device_name(c.device);
-  image_storage_from_string(c.image_storage);
-  return c;
-}
-
 Dqn::Dqn(const ObservationSpec& observation, int num_actions, const DqnConfig& config,
          std::uint64_t seed)
     : spec_(observation), num_actions_(num_actions), config_(config), device_(config.device),

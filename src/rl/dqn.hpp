@@ -23,33 +23,6 @@
 
 namespace comorph::rl {
 
-struct DqnConfig {
-  double gamma = 0.99;                  // discount per environment step
-  double learning_rate = 2.5e-4;        // Adam step size
-  double adam_epsilon = 1e-8;           // Adam's epsilon
-  int batch_size = 128;                 // transitions per update
-  std::int64_t buffer_size = 10000;     // replay capacity, transitions
-  std::int64_t learning_starts = 10000; // transitions stored before the first update
-  int train_frequency = 10;             // stored transitions between update rounds
-  int gradient_steps = 1;               // updates per round
-  int target_update_interval = 500;     // updates between target syncs
-  double tau = 1.0;                     // target sync: 1 = copy, <1 = Polyak weight
-  double epsilon_start = 1.0;           // exploration probability at the start
-  double epsilon_end = 0.05;            // ... after the decay
-  double epsilon_decay = 250000;        // transitions (store() calls) to decay over
-  std::string loss = "huber";           // "huber" (smooth L1, delta 1) or "mse"
-  double max_grad_norm = 0;             // clip the gradient's L2 norm; 0 = off
-  bool double_dqn = false;              // pick the next action with the online net
-  std::vector<int> hidden_sizes{120, 84};  // MLP head; [] + image-only obs = paper's net
-  int image_features = 256;             // CNN output size when an MLP head follows
-  int image_fc_size = 256;              // the CNN's hidden FC layer
-  std::string image_storage = "uint8";  // replay images: "uint8" or "float16"
-  std::string device = "cpu";           // torch device of nets and batches
-
-  // Fields present in `node` override the defaults; unknown fields throw.
-  static DqnConfig from_yaml(const YAML::Node& node, const std::string& source);
-};
-
 class Dqn final : public Learner {
  public:
   Dqn(const ObservationSpec& observation, int num_actions, const DqnConfig& config,

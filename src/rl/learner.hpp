@@ -21,8 +21,8 @@
 #include <vector>
 
 #include "common/torch_archive.hpp"  // save_archive: every save()
-#include "common/yaml_fields.hpp"  // YamlFields, load_yaml_file: every from_yaml
 #include "rl/env.hpp"
+#include "rl/learner_params.hpp"
 
 namespace torch::nn {
 class Module;
@@ -89,53 +89,6 @@ struct LinearSchedule {
 
 // Where the YAML presets are: <source dir>/configs/rl.
 std::string rl_config_dir();
-
-// "cpu", "cuda", "cuda:1" -> torch device; throws with the name if unknown or
-// not available here (a CUDA device without CUDA, an index past the last GPU).
-// (Declared with a string to keep torch out of this header.)
-void check_device_name(const std::string& name);
-
-// Smallest learning rate (and other "finite, > 0" settings) a config may give:
-// the ranges below also refuse nan and inf, whose comparisons all fail.
-inline constexpr double kMinPositive = 1e-12;
-// Largest count of transitions or steps a config may give (~10^12).
-inline constexpr std::int64_t kMaxSteps = 1000000000000;
-
-// The fields every learner's config has (DqnConfig, Td3Config, SacConfig), bound
-// under one set of YAML names with their ranges (docs/rl.md lists them); each
-// from_yaml adds its own fields next to these.
-template <class LearnerConfig>
-void add_shared_learner_fields(YamlFields& f, LearnerConfig& c) {
-  f.add("gamma", &c.gamma, 0.0, 1.0);
-  f.add("batch_size", &c.batch_size, 1, 1000000);
-  f.add("buffer_size", &c.buffer_size, 1, 1000000000);
-  f.add("learning_starts", &c.learning_starts, 0, kMaxSteps);
-  f.add("train_frequency", &c.train_frequency, 1, 1000000000);
-  f.add("gradient_steps", &c.gradient_steps, 1, 1000000);
-  f.add("tau", &c.tau, 0.0, 1.0);
-  f.add("max_grad_norm", &c.max_grad_norm, 0.0, 1e9);
-  f.add("hidden_sizes", &c.hidden_sizes);
-  f.add("image_features", &c.image_features, 1, 65536);
-  f.add("image_fc_size", &c.image_fc_size, 1, 65536);
-  f.add("image_storage", &c.image_storage);
-  f.add("device", &c.device);
-}
-
-// The fields TD3 and SAC (actor-critic learners) share, with their ranges.
-template <class ActorCriticConfig>
-void add_actor_critic_fields(YamlFields& f, ActorCriticConfig& c) {
-  f.add("actor_learning_rate", &c.actor_learning_rate, kMinPositive, 1.0);
-  f.add("critic_learning_rate", &c.critic_learning_rate, kMinPositive, 1.0);
-  f.add("random_action_steps", &c.random_action_steps, 0, kMaxSteps);
-  f.add("random_action_episodes", &c.random_action_episodes, 0, kMaxSteps);
-}
-
-// Layer widths must be positive (a list has no range of its own in YamlFields).
-template <class LearnerConfig>
-void check_hidden_sizes(const YamlFields& f, const LearnerConfig& c) {
-  for (int size : c.hidden_sizes)
-    if (size < 1 || size > 65536) f.fail("hidden_sizes", "layer width " + std::to_string(size) + " not in [1, 65536]");
-}
 
 // Sets the intra-op and inter-op thread counts of torch. The inter-op count
 // can only be set once per process; later calls leave it alone.

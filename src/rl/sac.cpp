@@ -6,33 +6,6 @@
 
 namespace comorph::rl {
 
-SacConfig SacConfig::from_yaml(const YAML::Node& node, const std::string& source) {
-  SacConfig c;
-  YamlFields f(source);
-  add_shared_learner_fields(f, c);
-  add_actor_critic_fields(f, c);
-  f.add("alpha_learning_rate", &c.alpha_learning_rate, kMinPositive, 1.0);
-  f.add("policy_frequency", &c.policy_frequency, 1, 1000000);
-  f.add("target_network_frequency", &c.target_network_frequency, 1, 1000000);
-  f.add("alpha", &c.alpha, kMinPositive, 1000.0);
-  f.add("autotune_alpha", &c.autotune_alpha);
-  f.add("target_entropy_scale", &c.target_entropy_scale, -100.0, 100.0);
-  f.add("log_std_min", &c.log_std_min, -20.0, 10.0);
-  f.add("log_std_max", &c.log_std_max, -20.0, 10.0);
-  f.add("share_encoder", &c.share_encoder);
-  f.apply(node);
-  check_hidden_sizes(f, c);
-  if (!(c.log_std_min < c.log_std_max)) f.fail("log_std_max", "must be above log_std_min");
-  if (c.batch_size <= 0 || c.buffer_size <= 0 || c.train_frequency <= 0 ||
-      c.policy_frequency <= 0 || c.target_network_frequency <= 0)
-    throw std::invalid_argument(source + ": batch_size, buffer_size, train_frequency, "
-                                         "policy_frequency and target_network_frequency must be > 0");
-  if (c.alpha <= 0) throw std::invalid_argument(source + ": field \"alpha\" must be > 0");
-  check_device_name(c.device);
-  image_storage_from_string(c.image_storage);
-  return c;
-}
-
 Sac::Sac(const ObservationSpec& observation, int action_dims, const SacConfig& config,
          std::uint64_t seed)
     : spec_(observation), action_dims_(action_dims), config_(config), device_(config.device),

@@ -20,37 +20,6 @@
 
 namespace comorph::rl {
 
-struct SacConfig {
-  double gamma = 0.99;                   // discount per environment step
-  double actor_learning_rate = 3e-4;     // Adam step size of the actor
-  double critic_learning_rate = 1e-3;    // Adam step size of the critics (+ encoder)
-  double alpha_learning_rate = 1e-3;     // Adam step size of log(alpha)
-  int batch_size = 256;                  // transitions per update
-  std::int64_t buffer_size = 1000000;    // replay capacity, transitions
-  std::int64_t learning_starts = 5000;   // transitions stored before the first update
-  std::int64_t random_action_steps = 5000;   // uniform random actions for this many transitions
-  std::int64_t random_action_episodes = 0;   // ... and for this many episodes
-  int train_frequency = 1;               // stored transitions between update rounds
-  int gradient_steps = 1;                // updates per round
-  int policy_frequency = 2;              // critic updates between actor rounds (each of this many steps)
-  int target_network_frequency = 1;      // critic updates between soft target updates
-  double tau = 0.005;                    // target Polyak weight
-  double alpha = 0.2;                    // entropy temperature (initial value when autotuned)
-  bool autotune_alpha = true;            // learn alpha towards the target entropy
-  double target_entropy_scale = 1.0;     // target entropy = -scale * action_dims (nats)
-  double log_std_min = -5.0;             // actor log-std range
-  double log_std_max = 2.0;
-  double max_grad_norm = 0;              // clip gradient L2 norms; 0 = off
-  std::vector<int> hidden_sizes{256, 256};  // actor and critic MLP hidden layers
-  int image_features = 16;               // CNN output size
-  int image_fc_size = 256;               // the CNN's hidden FC layer
-  bool share_encoder = true;             // actor uses the critic encoder's features (detached)
-  std::string image_storage = "uint8";   // replay images: "uint8" or "float16"
-  std::string device = "cpu";            // torch device of nets and batches
-
-  static SacConfig from_yaml(const YAML::Node& node, const std::string& source);
-};
-
 class Sac final : public Learner {
  public:
   Sac(const ObservationSpec& observation, int action_dims, const SacConfig& config,

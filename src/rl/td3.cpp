@@ -6,34 +6,6 @@
 
 namespace comorph::rl {
 
-Td3Config Td3Config::from_yaml(const YAML::Node& node, const std::string& source) {
-  Td3Config c;
-  YamlFields f(source);
-  add_shared_learner_fields(f, c);
-  add_actor_critic_fields(f, c);
-  f.add("policy_delay", &c.policy_delay, 1, 1000000);
-  f.add("policy_noise", &c.policy_noise, 0.0, 10.0);
-  f.add("noise_clip", &c.noise_clip, 0.0, 10.0);
-  f.add("exploration_noise_start", &c.exploration_noise_start, 0.0, 10.0);
-  f.add("exploration_noise_end", &c.exploration_noise_end, 0.0, 10.0);
-  f.add("exploration_noise_decay", &c.exploration_noise_decay, 0.0, 1e12);
-  f.add("exploration_noise_unit", &c.exploration_noise_unit);
-  f.add("share_encoder", &c.share_encoder);
-  f.add("bc_weight", &c.bc_weight, 0.0, 1000.0);
-  f.add("bc_decay_updates", &c.bc_decay_updates, std::int64_t(0), std::int64_t(1) << 40);
-  f.apply(node);
-  check_hidden_sizes(f, c);
-  if (c.exploration_noise_unit != "transitions" && c.exploration_noise_unit != "episodes")
-    throw std::invalid_argument(source + ": field \"exploration_noise_unit\" must be transitions "
-                                         "or episodes, got \"" + c.exploration_noise_unit + "\"");
-  if (c.batch_size <= 0 || c.buffer_size <= 0 || c.train_frequency <= 0 || c.policy_delay <= 0)
-    throw std::invalid_argument(source + ": batch_size, buffer_size, train_frequency and "
-                                         "policy_delay must be > 0");
-  check_device_name(c.device);
-  image_storage_from_string(c.image_storage);
-  return c;
-}
-
 Td3::Td3(const ObservationSpec& observation, int action_dims, const Td3Config& config,
          std::uint64_t seed)
     : spec_(observation), action_dims_(action_dims), config_(config), device_(config.device),

@@ -20,42 +20,6 @@
 
 namespace comorph::rl {
 
-struct Td3Config {
-  double gamma = 0.99;                   // discount per environment step
-  double actor_learning_rate = 3e-4;     // Adam step size of the actor
-  double critic_learning_rate = 3e-4;    // Adam step size of the critics (+ encoder)
-  int batch_size = 256;                  // transitions per update
-  std::int64_t buffer_size = 1000000;    // replay capacity, transitions
-  std::int64_t learning_starts = 25000;  // transitions stored before the first update
-  std::int64_t random_action_steps = 25000;  // uniform random actions for this many transitions
-  std::int64_t random_action_episodes = 0;   // ... and for this many episodes (paper: 300)
-  int train_frequency = 1;               // stored transitions between update rounds
-  int gradient_steps = 1;                // updates per round
-  int policy_delay = 2;                  // critic updates per actor + target update (d)
-  double tau = 0.005;                    // target Polyak weight (mu)
-  double policy_noise = 0.2;             // target smoothing noise std (action units, [-1, 1])
-  double noise_clip = 0.5;               // clip of the target smoothing noise
-  double exploration_noise_start = 0.1;  // exploration noise std at the start
-  double exploration_noise_end = 0.1;    // ... after the decay
-  double exploration_noise_decay = 0;    // decay length; 0 = constant `end`
-  std::string exploration_noise_unit = "transitions";  // decay counted in "transitions" or "episodes"
-  double max_grad_norm = 0;              // clip gradient L2 norms; 0 = off
-  // Behaviour cloning towards the demonstrator's action of the transitions that
-  // carry one (Action::target; TD3+BC, Fujimoto & Gu 2021):
-  // actor loss = -Q / mean|Q| + w * (squared error to the target, where there is one). w falls linearly from bc_weight to 0 over
-  // bc_decay_updates actor updates (0 = constant). bc_weight 0 = plain TD3.
-  double bc_weight = 0;
-  std::int64_t bc_decay_updates = 0;
-  std::vector<int> hidden_sizes{256, 256};  // actor and critic MLP hidden layers
-  int image_features = 16;               // CNN output size (paper: 16)
-  int image_fc_size = 256;               // the CNN's hidden FC layer
-  bool share_encoder = true;             // actor uses the critic encoder's features (detached)
-  std::string image_storage = "uint8";   // replay images: "uint8" or "float16"
-  std::string device = "cpu";            // torch device of nets and batches
-
-  static Td3Config from_yaml(const YAML::Node& node, const std::string& source);
-};
-
 class Td3 final : public Learner {
  public:
   Td3(const ObservationSpec& observation, int action_dims, const Td3Config& config,

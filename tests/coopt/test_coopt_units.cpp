@@ -67,7 +67,7 @@ TEST(CooptConfig, CiPresetLoadsAndSetOverridesNestedKeys) {
   EXPECT_EQ(c.trainer.episodes, 7);
   EXPECT_EQ(c.env.task.max_steps, 99);
   EXPECT_EQ(c.perception.switch_detector.interval, 30);
-  EXPECT_NE(c.td3_yaml.find("8"), std::string::npos);
+  EXPECT_EQ(c.td3.hidden_sizes, (std::vector<int>{8, 8}));
   EXPECT_NE(c.text.find("episodes: 7"), std::string::npos);
   EXPECT_EQ(c.preset, "ci");
   // The merged text reloads to the same config (what resume relies on).

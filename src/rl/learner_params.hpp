@@ -1,0 +1,157 @@
+// The hyperparameters of the learners (DQN, TD3, SAC), each declared once in
+// its struct with its default and unit, and their YAML reading with ranges.
+// No torch here: a run's config (coopt/config.hpp) holds them typed.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/yaml_fields.hpp"
+
+namespace comorph::rl {
+
+// "cpu", "cuda", "cuda:1" -> torch device; throws with the name if unknown or
+// not available here (a CUDA device without CUDA, an index past the last GPU).
+// (Declared with a string to keep torch out of this header.)
+void check_device_name(const std::string& name);
+
+// Smallest learning rate (and other "finite, > 0" settings) a config may give:
+// the ranges below also refuse nan and inf, whose comparisons all fail.
+inline constexpr double kMinPositive = 1e-12;
+// Largest count of transitions or steps a config may give (~10^12).
+inline constexpr std::int64_t kMaxSteps = 1000000000000;
+
+// The fields every learner's config has (DqnConfig, Td3Config, SacConfig), bound
+// under one set of YAML names with their ranges (docs/rl.md lists them); each
+// from_yaml adds its own fields next to these.
+template <class LearnerConfig>
+void add_shared_learner_fields(YamlFields& f, LearnerConfig& c) {
+  f.add("gamma", &c.gamma, 0.0, 1.0);
+  f.add("batch_size", &c.batch_size, 1, 1000000);
+  f.add("buffer_size", &c.buffer_size, 1, 1000000000);
+  f.add("learning_starts", &c.learning_starts, 0, kMaxSteps);
+  f.add("train_frequency", &c.train_frequency, 1, 1000000000);
+  f.add("gradient_steps", &c.gradient_steps, 1, 1000000);
+  f.add("tau", &c.tau, 0.0, 1.0);
+  f.add("max_grad_norm", &c.max_grad_norm, 0.0, 1e9);
+  f.add("hidden_sizes", &c.hidden_sizes);
+  f.add("image_features", &c.image_features, 1, 65536);
+  f.add("image_fc_size", &c.image_fc_size, 1, 65536);
+  f.add("image_storage", &c.image_storage);
+  f.add("device", &c.device);
+}
+
+// The fields TD3 and SAC (actor-critic learners) share, with their ranges.
+template <class ActorCriticConfig>
+void add_actor_critic_fields(YamlFields& f, ActorCriticConfig& c) {
+  f.add("actor_learning_rate", &c.actor_learning_rate, kMinPositive, 1.0);
+  f.add("critic_learning_rate", &c.critic_learning_rate, kMinPositive, 1.0);
+  f.add("random_action_steps", &c.random_action_steps, 0, kMaxSteps);
+  f.add("random_action_episodes", &c.random_action_episodes, 0, kMaxSteps);
+}
+
+// Layer widths must be positive (a list has no range of its own in YamlFields).
+template <class LearnerConfig>
+void check_hidden_sizes(const YamlFields& f, const LearnerConfig& c) {
+  for (int size : c.hidden_sizes)
+    if (size < 1 || size > 65536) f.fail("hidden_sizes", "layer width " + std::to_string(size) + " not in [1, 65536]");
+}
+
+struct DqnConfig {
+  double gamma = 0.99;                  // discount per environment step
+  double learning_rate = 2.5e-4;        // Adam step size
+  double adam_epsilon = 1e-8;           // Adam's epsilon
+  int batch_size = 128;                 // transitions per update
+  std::int64_t buffer_size = 10000;     // replay capacity, transitions
+  std::int64_t learning_starts = 10000; // transitions stored before the first update
+  int train_frequency = 10;             // stored transitions between update rounds
+  int gradient_steps = 1;               // updates per round
+  int target_update_interval = 500;     // updates between target syncs
+  double tau = 1.0;                     // target sync: 1 = copy, <1 = Polyak weight
+  double epsilon_start = 1.0;           // exploration probability at the start
+  double epsilon_end = 0.05;            // ... after the decay
+  double epsilon_decay = 250000;        // transitions (store() calls) to decay over
+  std::string loss = "huber";           // "huber" (smooth L1, delta 1) or "mse"
+  double max_grad_norm = 0;             // clip the gradient's L2 norm; 0 = off
+  bool double_dqn = false;              // pick the next action with the online net
+  std::vector<int> hidden_sizes{120, 84};  // MLP head; [] + image-only obs = paper's net
+  int image_features = 256;             // CNN output size when an MLP head follows
+  int image_fc_size = 256;              // the CNN's hidden FC layer
+  std::string image_storage = "uint8";  // replay images: "uint8" or "float16"
+  std::string device = "cpu";           // torch device of nets and batches
+
+  // Fields present in `node` override the defaults; unknown fields throw.
+  static DqnConfig from_yaml(const YAML::Node& node, const std::string& source);
+};
+
+struct Td3Config {
+  double gamma = 0.99;                   // discount per environment step
+  double actor_learning_rate = 3e-4;     // Adam step size of the actor
+  double critic_learning_rate = 3e-4;    // Adam step size of the critics (+ encoder)
+  int batch_size = 256;                  // transitions per update
+  std::int64_t buffer_size = 1000000;    // replay capacity, transitions
+  std::int64_t learning_starts = 25000;  // transitions stored before the first update
+  std::int64_t random_action_steps = 25000;  // uniform random actions for this many transitions
+  std::int64_t random_action_episodes = 0;   // ... and for this many episodes (paper: 300)
+  int train_frequency = 1;               // stored transitions between update rounds
+  int gradient_steps = 1;                // updates per round
+  int policy_delay = 2;                  // critic updates per actor + target update (d)
+  double tau = 0.005;                    // target Polyak weight (mu)
+  double policy_noise = 0.2;             // target smoothing noise std (action units, [-1, 1])
+  double noise_clip = 0.5;               // clip of the target smoothing noise
+  double exploration_noise_start = 0.1;  // exploration noise std at the start
+  double exploration_noise_end = 0.1;    // ... after the decay
+  double exploration_noise_decay = 0;    // decay length; 0 = constant `end`
+  std::string exploration_noise_unit = "transitions";  // decay counted in "transitions" or "episodes"
+  double max_grad_norm = 0;              // clip gradient L2 norms; 0 = off
+  // Behaviour cloning towards the demonstrator's action of the transitions that
+  // carry one (Action::target; TD3+BC, Fujimoto & Gu 2021):
+  // actor loss = -Q / mean|Q| + w * (squared error to the target, where there is one). w falls linearly from bc_weight to 0 over
+  // bc_decay_updates actor updates (0 = constant). bc_weight 0 = plain TD3.
+  double bc_weight = 0;
+  std::int64_t bc_decay_updates = 0;
+  std::vector<int> hidden_sizes{256, 256};  // actor and critic MLP hidden layers
+  int image_features = 16;               // CNN output size (paper: 16)
+  int image_fc_size = 256;               // the CNN's hidden FC layer
+  bool share_encoder = true;             // actor uses the critic encoder's features (detached)
+  std::string image_storage = "uint8";   // replay images: "uint8" or "float16"
+  std::string device = "cpu";            // torch device of nets and batches
+
+  static Td3Config from_yaml(const YAML::Node& node, const std::string& source);
+};
+
+struct SacConfig {
+  double gamma = 0.99;                   // discount per environment step
+  double actor_learning_rate = 3e-4;     // Adam step size of the actor
+  double critic_learning_rate = 1e-3;    // Adam step size of the critics (+ encoder)
+  double alpha_learning_rate = 1e-3;     // Adam step size of log(alpha)
+  int batch_size = 256;                  // transitions per update
+  std::int64_t buffer_size = 1000000;    // replay capacity, transitions
+  std::int64_t learning_starts = 5000;   // transitions stored before the first update
+  std::int64_t random_action_steps = 5000;   // uniform random actions for this many transitions
+  std::int64_t random_action_episodes = 0;   // ... and for this many episodes
+  int train_frequency = 1;               // stored transitions between update rounds
+  int gradient_steps = 1;                // updates per round
+  int policy_frequency = 2;              // critic updates between actor rounds (each of this many steps)
+  int target_network_frequency = 1;      // critic updates between soft target updates
+  double tau = 0.005;                    // target Polyak weight
+  double alpha = 0.2;                    // entropy temperature (initial value when autotuned)
+  bool autotune_alpha = true;            // learn alpha towards the target entropy
+  double target_entropy_scale = 1.0;     // target entropy = -scale * action_dims (nats)
+  double log_std_min = -5.0;             // actor log-std range
+  double log_std_max = 2.0;
+  double max_grad_norm = 0;              // clip gradient L2 norms; 0 = off
+  std::vector<int> hidden_sizes{256, 256};  // actor and critic MLP hidden layers
+  int image_features = 16;               // CNN output size
+  int image_fc_size = 256;               // the CNN's hidden FC layer
+  bool share_encoder = true;             // actor uses the critic encoder's features (detached)
+  std::string image_storage = "uint8";   // replay images: "uint8" or "float16"
+  std::string device = "cpu";            // torch device of nets and batches
+
+  static SacConfig from_yaml(const YAML::Node& node, const std::string& source);
+};
+
+}  // namespace comorph::rl
