@@ -94,7 +94,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
               "learner_thread", "torch_threads", "motion_image", "config_vector", "scene_source",
               "motion_clearance", "normalize_state", "decision_camera", "warmup_policy", "warmup_noise",
               "scripted_interval", "pilot_random_configs", "pilot_gait_per_modules", "pilot_labels",
-              "config_learns_from_pilot",
+              "greedy_motion_interval", "config_learns_from",
               "classifier_dir", "scenario", "stair_height", "eval_interval", "eval_episodes", "eval_seed",
               "checkpoint_interval", "progress_interval", "env_dir"});
   if (!n || n.IsNull()) return p;
@@ -102,7 +102,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   YamlFields f(source);
   YAML::Node numbers(YAML::NodeType::Map);
   const std::vector<std::string> strings{"mode",     "motion_algo", "scene_source", "classifier_dir",
-                                         "scenario", "env_dir",     "warmup_policy"};
+                                         "scenario", "env_dir",     "warmup_policy", "config_learns_from"};
   for (const auto& kv : n) {
     const std::string k = kv.first.as<std::string>();
     bool is_string = false;
@@ -126,7 +126,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   f.add(pre + ".pilot_random_configs", &p.pilot_random_configs);
   f.add(pre + ".pilot_gait_per_modules", &p.pilot_gait_per_modules);
   f.add(pre + ".pilot_labels", &p.pilot_labels);
-  f.add(pre + ".config_learns_from_pilot", &p.config_learns_from_pilot);
+  f.add(pre + ".greedy_motion_interval", &p.greedy_motion_interval, 0, 10000000);
   f.add(pre + ".stair_height", &p.stair_height, 0, 0.5);
   f.add(pre + ".eval_interval", &p.eval_interval, 0, 10000000);
   f.add(pre + ".eval_episodes", &p.eval_episodes, 1, 100000);
@@ -140,12 +140,16 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
                                                                : s == "classifier_dir" ? p.classifier_dir
                                                                : s == "scenario" ? p.scenario
                                                                : s == "warmup_policy" ? p.warmup_policy
+                                                               : s == "config_learns_from" ? p.config_learns_from
                                                                                  : p.env_dir);
   one_of(source, pre + ".mode", p.mode, {"hierarchical", "fixed"});
   one_of(source, pre + ".motion_algo", p.motion_algo, {"td3", "sac"});
   one_of(source, pre + ".scene_source", p.scene_source, {"ground_truth", "classifier"});
   one_of(source, pre + ".scenario", p.scenario, {"default", "obstacles7", "obstacles8", "mixed"});
   one_of(source, pre + ".warmup_policy", p.warmup_policy, {"random", "scripted"});
+  one_of(source, pre + ".config_learns_from", p.config_learns_from, {"all", "model", "greedy"});
+  if (p.config_learns_from == "greedy" && p.greedy_motion_interval < 1)
+    fail(source, pre + ".config_learns_from", "greedy needs trainer.greedy_motion_interval >= 1");
   // A run without a single episode would end at once with no checkpoint to resume or evaluate.
   if (p.warmup_episodes + p.episodes < 1)
     fail(source, pre + ".episodes", "warmup_episodes + episodes must be at least 1");

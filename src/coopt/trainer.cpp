@@ -173,6 +173,7 @@ struct LearnHooks {
   bool pilot_drives = false;
   double pilot_noise = 0;
   std::mt19937_64* pilot_rng = nullptr;
+  bool motion_greedy = false;  // the motion model acts without exploration noise
   Laps* laps = nullptr;  // the trainer's timing (TrainerTiming)
 };
 
@@ -298,7 +299,8 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
   const task::StepResult* r = nullptr;
   std::int64_t saturated = 0;
   while (true) {
-    agent.motion->act(b.obs, explore, b.action);  // also when the pilot drives: the same RNG stream
+    // Also when the pilot drives: the same RNG stream.
+    agent.motion->act(b.obs, explore && !(hooks && hooks->motion_greedy), b.action);
     if (pilot) {
       control::MotionMode pilot_mode;
       b.action.target.resize(control::kActionSize);  // sized once: no allocation after the first step
@@ -740,7 +742,11 @@ struct Trainer::Impl {
     };
     const bool scripted = t.warmup_policy == "scripted" &&
                           (warmup || (t.scripted_interval > 0 && episode % t.scripted_interval == 0));
-    const bool config_learns = !scripted || t.config_learns_from_pilot;
+    const bool greedy_motion = !warmup && !scripted && t.greedy_motion_interval > 0 &&
+                               episode % t.greedy_motion_interval == 1 % t.greedy_motion_interval;
+    const bool config_learns = t.config_learns_from == "all" || (t.config_learns_from == "model" && !scripted) ||
+                               (t.config_learns_from == "greedy" && greedy_motion);
+    hooks.motion_greedy = greedy_motion;
     hooks.config = [this, config_learns](const rl::Observation& o, const rl::Action& a, float r2,
                                          const rl::Observation& n, bool term, bool trunc, int k) {
       if (!config_learns) return;

@@ -166,24 +166,36 @@ TEST(Trainer, ScriptedWarmupDrivesTowardsTheGoal) {
   fs::remove_all(b);
 }
 
-// trainer.config_learns_from_pilot=false: the DQN stores (and reports) no
-// transition of the pilot's episodes (the 2 warm-up ones, then every 2nd), and
-// one or more of each of the motion model's; true: of every episode.
-TEST(Trainer, ConfigModelCanLearnOnlyFromTheMotionModelsEpisodes) {
-  const std::string a = temp_dir("dqn_all"), b = temp_dir("dqn_own");
-  std::vector<std::string> all = kWithDemonstrations, own = kWithDemonstrations;
-  all.push_back("trainer.config_learns_from_pilot=true");
-  own.push_back("trainer.config_learns_from_pilot=false");
+// trainer.config_learns_from: the DQN stores (and reports) the decisions of
+// every episode (all), of those the motion model drove (model: not the 2
+// warm-up episodes, nor every 2nd), or of those it drove greedily (greedy,
+// every 4th: episode 5). trainer.greedy_motion_interval alone changes that
+// episode (no exploration noise) and none before it.
+TEST(Trainer, ConfigModelLearnsFromTheChosenEpisodes) {
+  const auto run = [](const std::string& from, int greedy_interval, const std::string& name) {
+    std::vector<std::string> sets = kWithDemonstrations;
+    sets.push_back("trainer.config_learns_from=" + from);
+    sets.push_back("trainer.greedy_motion_interval=" + std::to_string(greedy_interval));
+    const std::string dir = temp_dir(name);
+    RunResult r = run_ci(sets, dir);
+    fs::remove_all(dir);
+    return r;
+  };
   const auto episodes_with_decisions = [](const RunResult& r) {
     std::vector<int> e;
     for (const auto& d : r.decisions)
       if (e.empty() || e.back() != d.episode) e.push_back(d.episode);
     return e;
   };
-  EXPECT_EQ(episodes_with_decisions(run_ci(all, a)), (std::vector<int>{0, 1, 2, 3, 4, 5}));
-  EXPECT_EQ(episodes_with_decisions(run_ci(own, b)), (std::vector<int>{3, 5}));
-  fs::remove_all(a);
-  fs::remove_all(b);
+  const RunResult all = run("all", 0, "dqn_all"), model = run("model", 0, "dqn_model");
+  const RunResult greedy = run("greedy", 4, "dqn_greedy"), model_greedy5 = run("model", 4, "dqn_model_greedy");
+  EXPECT_EQ(episodes_with_decisions(all), (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(episodes_with_decisions(model), (std::vector<int>{3, 5}));
+  EXPECT_EQ(episodes_with_decisions(greedy), (std::vector<int>{5}));
+  ASSERT_EQ(model_greedy5.episodes.size(), 6u);
+  ASSERT_EQ(model.episodes.size(), 6u);
+  for (int e = 0; e < 5; ++e) EXPECT_EQ(model_greedy5.episodes[e], model.episodes[e]) << "episode " << e;
+  EXPECT_NE(model_greedy5.episodes[5], model.episodes[5]);
 }
 
 TEST(Trainer, ResumeAfterInterruptionContinuesTheSameEpisodesWithIdenticalResults) {
