@@ -6,6 +6,13 @@
 
 namespace comorph::rl {
 
+void check_layer_widths(const YamlFields& f, const std::vector<int>& hidden_sizes) {
+  for (int size : hidden_sizes)
+    if (size < 1 || size > 65536) f.fail("hidden_sizes", "layer width " + std::to_string(size) + " not in [1, 65536]");
+}
+
+void check_image_storage(const std::string& name) { image_storage_from_string(name); }
+
 DqnConfig DqnConfig::from_yaml(const YAML::Node& node, const std::string& source) {
   DqnConfig c;
   YamlFields f(source);
@@ -19,18 +26,11 @@ DqnConfig DqnConfig::from_yaml(const YAML::Node& node, const std::string& source
   f.add("loss", &c.loss);
   f.add("double_dqn", &c.double_dqn);
   f.apply(node);
-  check_hidden_sizes(f, c);
+  check_shared_learner_fields(f, c);
   if (c.loss != "huber" && c.loss != "mse")
     throw std::invalid_argument(source + ": field \"loss\" must be huber or mse, got \"" + c.loss + "\"");
-  if (c.batch_size <= 0 || c.buffer_size <= 0 || c.train_frequency <= 0 ||
-      c.target_update_interval <= 0)
-    throw std::invalid_argument(source + ": batch_size, buffer_size, train_frequency and "
-                                         "target_update_interval must be > 0");
-  check_device_name(c.device);
-  image_storage_from_string(c.image_storage);
   return c;
 }
-
 
 Td3Config Td3Config::from_yaml(const YAML::Node& node, const std::string& source) {
   Td3Config c;
@@ -48,18 +48,12 @@ Td3Config Td3Config::from_yaml(const YAML::Node& node, const std::string& source
   f.add("bc_weight", &c.bc_weight, 0.0, 1000.0);
   f.add("bc_decay_updates", &c.bc_decay_updates, std::int64_t(0), std::int64_t(1) << 40);
   f.apply(node);
-  check_hidden_sizes(f, c);
+  check_shared_learner_fields(f, c);
   if (c.exploration_noise_unit != "transitions" && c.exploration_noise_unit != "episodes")
     throw std::invalid_argument(source + ": field \"exploration_noise_unit\" must be transitions "
                                          "or episodes, got \"" + c.exploration_noise_unit + "\"");
-  if (c.batch_size <= 0 || c.buffer_size <= 0 || c.train_frequency <= 0 || c.policy_delay <= 0)
-    throw std::invalid_argument(source + ": batch_size, buffer_size, train_frequency and "
-                                         "policy_delay must be > 0");
-  check_device_name(c.device);
-  image_storage_from_string(c.image_storage);
   return c;
 }
-
 
 SacConfig SacConfig::from_yaml(const YAML::Node& node, const std::string& source) {
   SacConfig c;
@@ -76,17 +70,9 @@ SacConfig SacConfig::from_yaml(const YAML::Node& node, const std::string& source
   f.add("log_std_max", &c.log_std_max, -20.0, 10.0);
   f.add("share_encoder", &c.share_encoder);
   f.apply(node);
-  check_hidden_sizes(f, c);
+  check_shared_learner_fields(f, c);
   if (!(c.log_std_min < c.log_std_max)) f.fail("log_std_max", "must be above log_std_min");
-  if (c.batch_size <= 0 || c.buffer_size <= 0 || c.train_frequency <= 0 ||
-      c.policy_frequency <= 0 || c.target_network_frequency <= 0)
-    throw std::invalid_argument(source + ": batch_size, buffer_size, train_frequency, "
-                                         "policy_frequency and target_network_frequency must be > 0");
-  if (c.alpha <= 0) throw std::invalid_argument(source + ": field \"alpha\" must be > 0");
-  check_device_name(c.device);
-  image_storage_from_string(c.image_storage);
   return c;
 }
-
 
 }  // namespace comorph::rl

@@ -53,11 +53,15 @@ void add_actor_critic_fields(YamlFields& f, ActorCriticConfig& c) {
   f.add("random_action_episodes", &c.random_action_episodes, 0, kMaxSteps);
 }
 
-// Layer widths must be positive (a list has no range of its own in YamlFields).
+// What the ranges of add_shared_learner_fields cannot say: layer widths
+// positive (a list has no range of its own), a known device and image storage.
+void check_layer_widths(const YamlFields& f, const std::vector<int>& hidden_sizes);
+void check_image_storage(const std::string& name);  // "uint8" | "float16", throws otherwise
 template <class LearnerConfig>
-void check_hidden_sizes(const YamlFields& f, const LearnerConfig& c) {
-  for (int size : c.hidden_sizes)
-    if (size < 1 || size > 65536) f.fail("hidden_sizes", "layer width " + std::to_string(size) + " not in [1, 65536]");
+void check_shared_learner_fields(const YamlFields& f, const LearnerConfig& c) {
+  check_layer_widths(f, c.hidden_sizes);
+  check_device_name(c.device);
+  check_image_storage(c.image_storage);
 }
 
 struct DqnConfig {
