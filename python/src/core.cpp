@@ -69,6 +69,21 @@ void read_action(const py::handle& action, float* out, const std::string& where)
   }
 }
 
+// Eq. 1's metrics of an ended episode, as the info keys of both envs.
+struct MetricField {
+  const char* key;
+  double (*get)(const task::Metrics&);
+};
+const MetricField kMetricFields[] = {
+    {"T", [](const task::Metrics& m) { return m.T; }},
+    {"E", [](const task::Metrics& m) { return m.E; }},
+    {"D", [](const task::Metrics& m) { return m.D; }},
+    {"F", [](const task::Metrics& m) { return m.F; }},
+    {"time_s", [](const task::Metrics& m) { return m.time_s; }},
+    {"episode_energy_J", [](const task::Metrics& m) { return m.energy_J; }},
+};
+constexpr const char* kEpisodeSteps = "episode_steps";
+
 // ---------------------------------------------------------------------------
 // One env.
 
@@ -159,13 +174,8 @@ class PyEnv {
     info["stairs_climbed"] = e.stairs_climbed();
   }
   static void metrics_into(const task::Metrics& m, py::dict& d) {
-    d["T"] = m.T;
-    d["E"] = m.E;
-    d["D"] = m.D;
-    d["F"] = m.F;
-    d["time_s"] = m.time_s;
-    d["episode_energy_J"] = m.energy_J;
-    d["episode_steps"] = m.steps;
+    for (const MetricField& f : kMetricFields) d[f.key] = f.get(m);
+    d[kEpisodeSteps] = m.steps;
   }
 
   EnvCore core_;
@@ -254,6 +264,7 @@ class PyVectorEnv {
     EnvOptions o = options;
     o.cache = std::make_shared<sim::ModelCache>(o.config.robot, o.config.scene);  // compiled once for all envs
     for (int i = 0; i < num_envs; ++i) envs_.push_back(std::make_unique<EnvCore>(o));
+    final_metrics_.resize(static_cast<std::size_t>(num_envs));
     workers_ = std::make_unique<Workers>(std::min(threads, num_envs));
     const task::EnvSpec s = envs_[0]->env().spec();
     depth_size_ = s.depth_channels * s.depth_height * s.depth_width;
@@ -313,14 +324,9 @@ class PyVectorEnv {
         if (ended) {
           // Same-step autoreset: the final observation and metrics go to
           // final_obs / final_info, the returned observation is the next episode's first.
-          const task::Metrics m = e.env().metrics();
-          out.T_p[i] = m.T, out.E_p[i] = m.E, out.D_p[i] = m.D, out.F_p[i] = m.F;
-          out.time_p[i] = m.time_s, out.ep_energy_p[i] = m.energy_J, out.ep_steps_p[i] = m.steps;
+          final_metrics_[i] = e.env().metrics();
           write_observation(i, out, true);
           e.reset(std::nullopt, 0, 0.0);
-        } else {
-          out.T_p[i] = out.E_p[i] = out.D_p[i] = out.F_p[i] = out.time_p[i] = out.ep_energy_p[i] = NAN;
-          out.ep_steps_p[i] = 0;
         }
         write_observation(i, out);
       });
@@ -332,14 +338,16 @@ class PyVectorEnv {
     info["energy_J"] = out.energy;
     info["_final_obs"] = out.final_mask;
     info["final_obs"] = out.final_obs;
-    py::dict final_info;
-    final_info["T"] = out.T;
-    final_info["E"] = out.E;
-    final_info["D"] = out.D;
-    final_info["F"] = out.F;
-    final_info["time_s"] = out.time;
-    final_info["episode_energy_J"] = out.ep_energy;
-    final_info["episode_steps"] = out.ep_steps;
+    py::dict final_info;  // per metric an array: the ended episodes' values, NaN (steps 0) elsewhere
+    for (const MetricField& f : kMetricFields) {
+      py::array_t<double> column(n);
+      double* p = column.mutable_data();
+      for (int i = 0; i < n; ++i) p[i] = out.final_mask_p[i] ? f.get(final_metrics_[i]) : NAN;
+      final_info[f.key] = column;
+    }
+    py::array_t<int> steps(n);
+    for (int i = 0; i < n; ++i) steps.mutable_data()[i] = out.final_mask_p[i] ? final_metrics_[i].steps : 0;
+    final_info[kEpisodeSteps] = steps;
     info["final_info"] = final_info;
     info["_final_info"] = out.final_mask;
     return py::make_tuple(out.obs, out.reward, out.terminated, out.truncated, info);
@@ -351,14 +359,13 @@ class PyVectorEnv {
     FloatArray depth, state, clearance, f_depth, f_state, f_clearance;
     float *depth_p = nullptr, *state_p = nullptr, *clearance_p = nullptr;
     float *f_depth_p = nullptr, *f_state_p = nullptr, *f_clearance_p = nullptr;
-    py::array_t<int> scene, reason, ep_steps;
+    py::array_t<int> scene, reason;
     py::array_t<std::uint64_t> seed;
-    py::array_t<double> reward, energy, T, E, D, F, time, ep_energy;
+    py::array_t<double> reward, energy;
     py::array_t<bool> terminated, truncated, final_mask;
-    int *scene_p = nullptr, *reason_p = nullptr, *ep_steps_p = nullptr;
+    int *scene_p = nullptr, *reason_p = nullptr;
     std::uint64_t* seed_p = nullptr;
-    double *reward_p = nullptr, *energy_p = nullptr, *T_p = nullptr, *E_p = nullptr, *D_p = nullptr, *F_p = nullptr,
-           *time_p = nullptr, *ep_energy_p = nullptr;
+    double *reward_p = nullptr, *energy_p = nullptr;
     bool *terminated_p = nullptr, *truncated_p = nullptr, *final_mask_p = nullptr;
   };
 
@@ -387,11 +394,9 @@ class PyVectorEnv {
     obs_arrays(o.final_obs, o.f_depth, o.f_state, o.f_clearance, o.f_depth_p, o.f_state_p, o.f_clearance_p, true);
     auto d = [n](py::array_t<double>& a, double*& p) { a = py::array_t<double>(n), p = a.mutable_data(); };
     auto b = [n](py::array_t<bool>& a, bool*& p) { a = py::array_t<bool>(n), p = a.mutable_data(); };
-    d(o.reward, o.reward_p), d(o.energy, o.energy_p), d(o.T, o.T_p), d(o.E, o.E_p), d(o.D, o.D_p), d(o.F, o.F_p);
-    d(o.time, o.time_p), d(o.ep_energy, o.ep_energy_p);
+    d(o.reward, o.reward_p), d(o.energy, o.energy_p);
     b(o.terminated, o.terminated_p), b(o.truncated, o.truncated_p), b(o.final_mask, o.final_mask_p);
     o.reason = py::array_t<int>(n), o.reason_p = o.reason.mutable_data();
-    o.ep_steps = py::array_t<int>(n), o.ep_steps_p = o.ep_steps.mutable_data();
     return o;
   }
 
@@ -415,6 +420,7 @@ class PyVectorEnv {
   }
 
   std::vector<std::unique_ptr<EnvCore>> envs_;
+  std::vector<task::Metrics> final_metrics_;  // of the episodes that ended in the last step
   std::unique_ptr<Workers> workers_;
   std::vector<float> actions_;
   int depth_size_ = 0, clearance_size_ = 0;
