@@ -13,6 +13,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstring>
+#include <ctime>
 #include <exception>
 #include <memory>
 #include <mutex>
@@ -471,19 +472,32 @@ Configuration to_configuration(const py::handle& C_a, const py::handle& C_s) {
 
 py::tuple from_configuration(const Configuration& c) { return py::make_tuple(write_matrix(c.C_a), write_matrix(c.C_s)); }
 
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
 // The C++ loop of bench/python: `steps` control steps of one env with a fixed
-// action (a new episode, seed + k, when one ends), wall seconds.
-double cpp_loop_seconds(const EnvOptions& options, std::uint64_t seed, int steps, const std::vector<float>& action) {
+// action (the next episode of the seed's stream when one ends), as
+// (wall seconds, this thread's CPU seconds).
+py::tuple cpp_loop_seconds(const EnvOptions& options, std::uint64_t seed, int steps, const std::vector<float>& action) {
   if (action.size() != control::kActionSize) throw std::invalid_argument("action: expected 5 floats");
-  py::gil_scoped_release release;
-  EnvCore core(options);
-  core.reset(seed, 0, 0.0);
-  const auto start = std::chrono::steady_clock::now();
-  for (int i = 0; i < steps; ++i) {
-    const task::StepResult& r = core.step(action.data());
-    if (r.terminated || r.truncated) core.reset(std::nullopt, 0, 0.0);
+  double wall = 0, cpu = 0;
+  {
+    py::gil_scoped_release release;
+    EnvCore core(options);
+    core.reset(seed, 0, 0.0);
+    const auto start = std::chrono::steady_clock::now();
+    const double cpu_start = thread_cpu_seconds();
+    for (int i = 0; i < steps; ++i) {
+      const task::StepResult& r = core.step(action.data());
+      if (r.terminated || r.truncated) core.reset(std::nullopt, 0, 0.0);
+    }
+    cpu = thread_cpu_seconds() - cpu_start;
+    wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return py::make_tuple(wall, cpu);
 }
 
 EnvOptions env_options(const std::string& config_dir, const py::object& env_config, int modules, int obstacles,
