@@ -90,7 +90,7 @@ std::vector<std::string> column_sets(const ExperimentOptions& o, const Column& c
 // `expected` is the column's config (--config + column_sets).
 bool train_column(const ExperimentOptions& o, const Column& column, const comorph::coopt::CooptConfig& expected,
                   const std::string& run_dir, ColumnTimes& times) {
-  const int total = expected.trainer.warmup_episodes + expected.trainer.episodes;
+  const int total = expected.trainer.total_episodes();
 
   if (!comorph::cli::is_empty_run_dir(run_dir)) {
     const fs::path existing_config = fs::path(run_dir) / "config.yaml";

@@ -212,7 +212,7 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
     info.modules = config.trainer.mode == "fixed" ? config.trainer.fixed_modules : comorph::coopt::kMaxModules;
     info.algo = config.trainer.motion_algo;
     info.scenario = config.trainer.scenario;
-    info.episodes = config.trainer.warmup_episodes + config.trainer.episodes;
+    info.episodes = config.trainer.total_episodes();
     info.preset = config.preset;
     info.notes = "scene source: " + config.trainer.scene_source;
     comorph::report::write_run_info((fs::path(run_dir) / "run.yaml").string(), info);

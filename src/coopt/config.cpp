@@ -95,6 +95,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
               "motion_clearance", "normalize_state", "decision_camera", "warmup_policy", "warmup_noise",
               "scripted_interval", "pilot_random_configs", "pilot_gait_per_modules", "pilot_labels",
               "greedy_motion_interval", "config_learns_from",
+              "config_refit_episodes",
               "classifier_dir", "scenario", "stair_height", "eval_interval", "eval_episodes", "eval_seed",
               "checkpoint_interval", "progress_interval", "env_dir"});
   if (!n || n.IsNull()) return p;
@@ -127,6 +128,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   f.add(pre + ".pilot_gait_per_modules", &p.pilot_gait_per_modules);
   f.add(pre + ".pilot_labels", &p.pilot_labels);
   f.add(pre + ".greedy_motion_interval", &p.greedy_motion_interval, 0, 10000000);
+  f.add(pre + ".config_refit_episodes", &p.config_refit_episodes, 0, 10000000);
   f.add(pre + ".stair_height", &p.stair_height, 0, 0.5);
   f.add(pre + ".eval_interval", &p.eval_interval, 0, 10000000);
   f.add(pre + ".eval_episodes", &p.eval_episodes, 1, 100000);
@@ -153,6 +155,8 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   // A run without a single episode would end at once with no checkpoint to resume or evaluate.
   if (p.warmup_episodes + p.episodes < 1)
     fail(source, pre + ".episodes", "warmup_episodes + episodes must be at least 1");
+  if (p.config_refit_episodes > 0 && p.mode != "hierarchical")
+    fail(source, pre + ".config_refit_episodes", "needs trainer.mode hierarchical (a fixed chain has no DQN)");
   if (p.scene_source == "classifier") {
     if (p.classifier_dir.empty())
       fail(source, pre + ".classifier_dir", "scene_source: classifier needs the directory of a trained classifier");

@@ -73,6 +73,13 @@ struct TrainerParams {
   // cannot drive yet, and the exploring model with chains the greedy one
   // cannot (3 modules at 0.06 m: 40 of 43 exploring, 0 of 10 greedy).
   std::string config_learns_from = "all";
+  // After the training episodes, this many more in which the motion model is
+  // frozen and greedy and a fresh DQN (the dqn: section, its own epsilon
+  // schedule) learns from every decision. Its values then describe the final
+  // motion model; during training they mix every stage of it, and the early
+  // ones stay in its replay. 0 = none.
+  int config_refit_episodes = 0;
+  int total_episodes() const { return warmup_episodes + episodes + config_refit_episodes; }
   // Every training transition carries the pilot's action for its state as a
   // behaviour-cloning target (td3.bc_weight), also where the motion model drove:
   // the pilot labels the states the learner visits (DAgger, Ross et al. 2011).

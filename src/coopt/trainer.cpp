@@ -578,11 +578,11 @@ CheckpointInfo read_checkpoint_info(const std::string& run_dir) {
 }
 
 void check_checkpoint_counts(const CheckpointInfo& info, const CooptConfig& config) {
-  const int total = config.trainer.warmup_episodes + config.trainer.episodes;
+  const int total = config.trainer.total_episodes();
   if (info.episodes < 0 || info.episodes > total)
     throw std::runtime_error(info.directory + ": the checkpoint counts " + std::to_string(info.episodes) +
                              " episodes, the config has " + std::to_string(total) +
-                             " (warm-up + training); refusing to resume");
+                             " (warm-up + training + DQN refit); refusing to resume");
   if (info.evaluations < 0 || info.evaluations > info.episodes)
     throw std::runtime_error(info.directory + ": the checkpoint counts " + std::to_string(info.evaluations) +
                              " evaluations after " + std::to_string(info.episodes) +
@@ -722,29 +722,42 @@ struct Trainer::Impl {
   EpisodeLog train_episode() {
     const TrainerParams& t = config.trainer;
     const bool warmup = episode < t.warmup_episodes;
+    // The DQN refit (trainer.config_refit_episodes): a fresh DQN on the frozen,
+    // greedy motion model; no pilot, nothing stored for the motion learner.
+    const bool refit = episode >= t.warmup_episodes + t.episodes;
+    if (refit && episode == t.warmup_episodes + t.episodes) {
+      agent.config = make_config_model(config, static_cast<std::uint64_t>(t.seed) + 3);
+      config_segments = {};  // its replay starts empty: no segment of the old one to link
+    }
     LearnHooks hooks;
     hooks.laps = &laps;
-    hooks.motion = [this](const rl::Observation& o, const rl::Action& a, float r, const rl::Observation& n,
-                          bool term, bool trunc) {
-      agent.motion->store(o, a, r, n, term, trunc);  // keeps the acting copy's exploration counters
-      Transition& tr = record ? (*record)[recorded++] : pending[filling][filled++];
-      tr.obs.image = o.image;  // same sizes: copies, no allocation
-      tr.obs.vector = o.vector;
-      tr.next.image = n.image;
-      tr.next.vector = n.vector;
-      tr.action.continuous = a.continuous;
-      tr.action.target = a.target;
-      tr.reward = r;
-      tr.terminated = term;
-      tr.truncated = trunc;
-      ++steps;
-      if (!record && filled == config.trainer.sync_interval) hand_over();
-    };
-    const bool scripted = t.warmup_policy == "scripted" &&
+    if (refit)
+      hooks.motion = [this](const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool) {
+        ++steps;
+      };
+    else
+      hooks.motion = [this](const rl::Observation& o, const rl::Action& a, float r, const rl::Observation& n,
+                            bool term, bool trunc) {
+        agent.motion->store(o, a, r, n, term, trunc);  // keeps the acting copy's exploration counters
+        Transition& tr = record ? (*record)[recorded++] : pending[filling][filled++];
+        tr.obs.image = o.image;  // same sizes: copies, no allocation
+        tr.obs.vector = o.vector;
+        tr.next.image = n.image;
+        tr.next.vector = n.vector;
+        tr.action.continuous = a.continuous;
+        tr.action.target = a.target;
+        tr.reward = r;
+        tr.terminated = term;
+        tr.truncated = trunc;
+        ++steps;
+        if (!record && filled == config.trainer.sync_interval) hand_over();
+      };
+    const bool scripted = !refit && t.warmup_policy == "scripted" &&
                           (warmup || (t.scripted_interval > 0 && episode % t.scripted_interval == 0));
-    const bool greedy_motion = !warmup && !scripted && t.greedy_motion_interval > 0 &&
-                               episode % t.greedy_motion_interval == 1 % t.greedy_motion_interval;
-    const bool config_learns = t.config_learns_from == "all" || (t.config_learns_from == "model" && !scripted) ||
+    const bool greedy_motion = refit || (!warmup && !scripted && t.greedy_motion_interval > 0 &&
+                                         episode % t.greedy_motion_interval == 1 % t.greedy_motion_interval);
+    const bool config_learns = refit || t.config_learns_from == "all" ||
+                               (t.config_learns_from == "model" && !scripted) ||
                                (t.config_learns_from == "greedy" && greedy_motion);
     hooks.motion_greedy = greedy_motion;
     hooks.config = [this, config_learns](const rl::Observation& o, const rl::Action& a, float r2,
@@ -775,7 +788,7 @@ struct Trainer::Impl {
           if (mask[a] && k-- == 0) return a;
         return -1;
       };
-    if (scripted || t.pilot_labels) {
+    if (scripted || (t.pilot_labels && !refit)) {
       hooks.pilot = &pilot;
       hooks.pilot_drives = scripted;
       hooks.pilot_noise = t.warmup_noise;
@@ -813,7 +826,7 @@ struct Trainer::Impl {
     recent_success.push_back(log.success ? 1.0 : 0.0);
     if (recent_success.size() > 20) recent_success.erase(recent_success.begin());
     const TrainerParams& t = config.trainer;
-    const int total = t.warmup_episodes + t.episodes;
+    const int total = t.total_episodes();
     if (episode % t.progress_interval != 0 && episode != total) return;
     double rate = 0;
     for (double s : recent_success) rate += s;
@@ -955,7 +968,7 @@ TrainerTiming Trainer::timing() const {
 bool Trainer::run(const std::atomic<bool>* stop) {
   Impl& m = *impl_;
   const TrainerParams& t = m.config.trainer;
-  const int total = t.warmup_episodes + t.episodes;
+  const int total = t.total_episodes();
   // run()'s time is timed, and every return (or exception) ends the laps.
   struct RunClock {
     Impl& m;
@@ -1003,7 +1016,7 @@ SideRates measure_side_rates(const CooptConfig& config, std::int64_t steps) {
   if (steps < 1) throw std::invalid_argument("measure_side_rates: steps must be >= 1");
   Trainer::Impl m(config, "", {});
   const TrainerParams& t = config.trainer;
-  const int total = t.warmup_episodes + t.episodes;
+  const int total = t.total_episodes();
   // The last episode may run past `steps` by up to a whole episode.
   std::vector<Transition> record(static_cast<std::size_t>(steps + config.env.task.max_steps + 1));
   for (Transition& tr : record) {

@@ -198,6 +198,51 @@ TEST(Trainer, ConfigModelLearnsFromTheChosenEpisodes) {
   EXPECT_NE(model_greedy5.episodes[5], model.episodes[5]);
 }
 
+// trainer.config_refit_episodes: the training episodes are those of a run
+// without it; then a fresh DQN learns from every decision of the refit
+// episodes while the motion model stays as it was (driving a fixed chain, both
+// runs' motion models give the same episodes, and their DQNs different ones);
+// interrupted inside the refit, the resumed run gives the same episodes.
+TEST(Trainer, ConfigRefitTrainsAFreshDqnOnTheFrozenMotionModel) {
+  std::vector<std::string> sets = kWithDemonstrations;
+  const std::string plain_dir = temp_dir("refit_plain"), refit_dir = temp_dir("refit");
+  const RunResult plain = run_ci(sets, plain_dir);
+  sets.push_back("trainer.config_refit_episodes=3");
+  const RunResult refit = run_ci(sets, refit_dir);
+  ASSERT_EQ(plain.episodes.size(), 6u);
+  ASSERT_EQ(refit.episodes.size(), 9u);
+  for (int e = 0; e < 6; ++e) EXPECT_EQ(refit.episodes[e], plain.episodes[e]) << "episode " << e;
+  std::vector<int> refit_decisions;
+  for (const auto& d : refit.decisions)
+    if (d.episode >= 6 && (refit_decisions.empty() || refit_decisions.back() != d.episode))
+      refit_decisions.push_back(d.episode);
+  EXPECT_EQ(refit_decisions, (std::vector<int>{6, 7, 8}));
+  const auto greedy_lines = [](CooptConfig c, const std::string& dir) {
+    std::vector<std::string> lines;
+    for (const EpisodeLog& l : evaluate(c, dir, {"default", 6, 4242, 1})) lines.push_back(line_of(l));
+    return lines;
+  };
+  CooptConfig plain_config = load_coopt_config(kCi, kWithDemonstrations);
+  CooptConfig refit_config = load_coopt_config(kCi, sets);
+  EXPECT_NE(greedy_lines(plain_config, plain_dir), greedy_lines(refit_config, refit_dir));
+  plain_config.trainer.mode = refit_config.trainer.mode = "fixed";  // the motion model alone
+  EXPECT_EQ(greedy_lines(plain_config, plain_dir), greedy_lines(refit_config, refit_dir));
+
+  const std::string dir = temp_dir("refit_resume");
+  const CooptConfig c = load_coopt_config(kCi, sets);
+  RunResult resumed;
+  run_until_stopped(c, dir, 6, resumed);  // stopped after the first refit episode
+  {
+    Trainer t(c, dir, collecting(resumed));
+    t.resume();
+    EXPECT_TRUE(t.run());
+  }
+  EXPECT_EQ(resumed.episodes, refit.episodes);
+  fs::remove_all(plain_dir);
+  fs::remove_all(refit_dir);
+  fs::remove_all(dir);
+}
+
 TEST(Trainer, ResumeAfterInterruptionContinuesTheSameEpisodesWithIdenticalResults) {
   const std::vector<std::string> sets{"trainer.episodes=6", "trainer.checkpoint_interval=3"};
   const std::string full_dir = temp_dir("full");
