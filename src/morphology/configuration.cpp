@@ -172,6 +172,35 @@ std::string validate(const Configuration& config) {
   return {};
 }
 
+int module_at_face(const Configuration& config, int module, int face) {
+  for (const auto& row : config.C_s) {
+    if (row[4] != 1) continue;
+    if (row[0] == module && row[2] == face) return row[1];
+    if (row[1] == module && row[3] == face) return row[0];
+  }
+  return 0;
+}
+
+std::string validate_sub_configuration(const Configuration& whole, const Configuration& part) {
+  if (std::string error = validate(whole); !error.empty()) return "the current configuration is invalid: " + error;
+  if (std::string error = validate(part); !error.empty()) return "the new configuration is invalid: " + error;
+  const int kept = module_count(part), had = module_count(whole);
+  if (kept >= had)
+    return "only shedding modules is possible: " + std::to_string(had) + " -> " + std::to_string(kept) +
+           " modules sheds none";
+  for (const auto& row : part.C_s) {
+    if (row[4] != 1) continue;
+    const int mi = row[0], mj = row[1], fi = row[2], fj = row[3];
+    if (module_at_face(whole, mi, fi) != mj || module_at_face(whole, mj, fj) != mi) {
+      std::ostringstream m;
+      m << "module " << mi << " face " << fi << " to module " << mj << " face " << fj
+        << " is not a connection of the current configuration";
+      return fault(m);
+    }
+  }
+  return {};
+}
+
 int module_count(const Configuration& config) {
   if (std::string error = validate(config); !error.empty())
     throw std::invalid_argument("invalid configuration: " + error);

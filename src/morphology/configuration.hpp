@@ -16,6 +16,8 @@
 
 namespace comorph {
 
+// The module limits of the whole project (sim, control, task and the
+// configuration model read them from here).
 inline constexpr int kMaxModules = 10;
 inline constexpr int kMinModules = 2;  // one module cannot climb (paper Sec. III-A)
 inline constexpr int kConnectionColumns = 5;
@@ -29,6 +31,10 @@ struct Configuration {
   AdjacencyMatrix C_a{};   // zero-initialised
   ConnectionMatrix C_s{};  // zero-initialised
 };
+inline bool operator==(const Configuration& a, const Configuration& b) {
+  return a.C_a == b.C_a && a.C_s == b.C_s;
+}
+inline bool operator!=(const Configuration& a, const Configuration& b) { return !(a == b); }
 
 // The chain of `modules` modules (kMinModules..kMaxModules); throws
 // std::invalid_argument outside that range.
@@ -36,8 +42,18 @@ Configuration make_chain(int modules);
 
 // Empty string when valid; otherwise a message that names the first fault
 // (asymmetric C_a, self-connection, loop, disconnected module, face used twice,
-// out-of-range index, C_a and C_s disagreeing, not a chain of 2..10 modules).
+// out-of-range index, C_a and C_s disagreeing, not a chain of
+// kMinModules..kMaxModules modules).
 std::string validate(const Configuration& config);
+
+// Empty string when `part` is what `whole` becomes by shedding modules: `part`
+// is valid, has fewer modules, and each of its connections is one of `whole`'s
+// (the same modules at the same faces). Otherwise names the first fault.
+std::string validate_sub_configuration(const Configuration& whole, const Configuration& part);
+
+// The module docked to face `face` of module `module` (1-based) through a
+// connected C_s row, 0 when that face is free.
+int module_at_face(const Configuration& config, int module, int face);
 
 // Number of modules of a valid configuration; throws std::invalid_argument with
 // validate()'s message when the configuration is not valid.
@@ -47,7 +63,7 @@ int module_count(const Configuration& config);
 // C_a is not validated here.
 ConnectionMatrix connections_from_adjacency(const AdjacencyMatrix& C_a);
 
-// C_a implied by the connected rows of `C_s` (indices outside 1..10 ignored).
+// C_a implied by the connected rows of `C_s` (indices outside 1..kMaxModules ignored).
 AdjacencyMatrix adjacency_from_connections(const ConnectionMatrix& C_s);
 
 // A short human-readable form, e.g. "chain of 4 modules: 1-2-3-4".

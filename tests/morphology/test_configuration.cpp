@@ -167,6 +167,42 @@ TEST(ConfigurationFaults, ModuleCountThrowsOnInvalid) {
   EXPECT_THROW(module_count(c), std::invalid_argument);
 }
 
+// Reconfiguration: a chain may shed tail modules, and nothing else.
+TEST(SubConfiguration, ShorterChainsAreSubConfigurationsOfLongerOnes) {
+  for (int n = kMinModules; n <= kMaxModules; ++n)
+    for (int m = kMinModules; m <= kMaxModules; ++m) {
+      const std::string fault = validate_sub_configuration(make_chain(n), make_chain(m));
+      EXPECT_EQ(fault.empty(), m < n) << n << " -> " << m << ": " << fault;
+    }
+  EXPECT_NE(validate_sub_configuration(make_chain(4), make_chain(4)).find("sheds none"), std::string::npos);
+  EXPECT_NE(validate_sub_configuration(make_chain(3), make_chain(5)).find("3 -> 5"), std::string::npos);
+}
+
+TEST(SubConfiguration, NamesAConnectionTheCurrentConfigurationLacks) {
+  // Modules 1 and 2 docked the other way round (1's back face to 2's back face)
+  // is not what the chain of 4 holds, even with fewer modules.
+  Configuration flipped;
+  connect(flipped, 1, 2);
+  flipped.C_s[0] = {1, 2, kBackFace, kBackFace, 1};
+  EXPECT_NE(validate_sub_configuration(make_chain(4), flipped).find("the new configuration is invalid"),
+            std::string::npos);
+  Configuration broken = make_chain(3);
+  broken.C_a[0][1] = 0;
+  EXPECT_NE(validate_sub_configuration(broken, make_chain(2)).find("the current configuration is invalid"),
+            std::string::npos);
+}
+
+TEST(SubConfiguration, ModuleAtFaceFollowsTheChain) {
+  const Configuration c = make_chain(3);
+  EXPECT_EQ(module_at_face(c, 1, kFrontFace), 0);  // the head's front face stays free
+  EXPECT_EQ(module_at_face(c, 1, kBackFace), 2);
+  EXPECT_EQ(module_at_face(c, 2, kFrontFace), 1);
+  EXPECT_EQ(module_at_face(c, 2, kBackFace), 3);
+  EXPECT_EQ(module_at_face(c, 3, kBackFace), 0);
+  EXPECT_EQ(c, make_chain(3));
+  EXPECT_NE(c, make_chain(4));
+}
+
 TEST(ConfigurationYaml, RoundTripThroughFile) {
   const std::string path = ::testing::TempDir() + "/config_roundtrip.yaml";
   for (int n = kMinModules; n <= kMaxModules; ++n) {
