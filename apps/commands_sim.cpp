@@ -50,7 +50,7 @@ void run_export(const SimOptions& o) {
   const task::EnvConfig c = load_config(o.config_dir);
   const sim::SceneLayout layout = sim::generate_scene(c.scene, o.seed, o.stair_height, o.obstacles,
                                                       sim::parse_variant(o.variant));
-  const std::string xml = sim::build_mjcf(o.modules, c.robot, c.scene, layout);
+  const std::string xml = sim::build_mjcf(make_chain(o.modules), c.robot, c.scene, layout);
   sim::compile_mjcf(xml);  // never hand out a file MuJoCo would reject
   std::cout << xml;
 }
@@ -97,7 +97,7 @@ void run_demo(const SimOptions& o) {
   task::MultiTaskEnv env(c);
   task::EpisodeSpec spec;
   spec.seed = o.seed;
-  spec.modules = o.modules;
+  spec.configuration = make_chain(o.modules);
   spec.stair_height = o.stair_height;
   spec.obstacles = o.obstacles;
   spec.variant = sim::parse_variant(o.variant);
@@ -131,9 +131,9 @@ void run_demo(const SimOptions& o) {
     if (r.stairs_climbed_now) {
       std::cout << fmt::format("  t={:6.2f} s  event: stairs climbed (energy on stairs {:.1f} J)\n", t,
                                env.stairs_energy());
-      if (o.shed_to >= 2 && o.shed_to < env.modules() && !env.done()) {
+      if (o.shed_to >= kMinModules && o.shed_to < env.modules() && !env.done()) {
         const int before = env.modules();
-        env.reconfigure(o.shed_to);
+        env.reconfigure(make_chain(o.shed_to));
         std::cout << fmt::format("  t={:6.2f} s  event: reconfigured {} -> {} modules (tail shed)\n", t, before,
                                  env.modules());
       }
@@ -164,8 +164,9 @@ void run_demo(const SimOptions& o) {
 
 comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   static SimOptions o;
+  static const std::string modules_help = fmt::format("number of modules ({}..{})", kMinModules, kMaxModules);
   auto* exp = app.add_subcommand("export-mjcf", "write the scene with a chain robot as MJCF to stdout");
-  exp->add_option("--modules,-n", o.modules, "number of modules (2..10)")->check(CLI::Range(2, 10));
+  exp->add_option("--modules,-n", o.modules, modules_help)->check(CLI::Range(kMinModules, kMaxModules));
   exp->add_option("--stair-height", o.stair_height, "m, step height (0 = drawn from the seed)")
       ->check(cli::finite_in(0, kMaxStairHeight));
   exp->add_option("--obstacles", o.obstacles, "K obstacles (-1 = scene default)")->check(cli::whole_in(-1, 50));
@@ -183,14 +184,14 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   table->callback([] { run_physics_table(o); });
 
   auto* demo = app.add_subcommand("demo", "a scripted controller drives the robot through the scenario");
-  demo->add_option("--modules,-n", o.modules, "number of modules (2..10)")->check(CLI::Range(2, 10));
+  demo->add_option("--modules,-n", o.modules, modules_help)->check(CLI::Range(kMinModules, kMaxModules));
   demo->add_option("--seed", o.seed, "scene seed")->check(cli::whole_in(0, kMaxSeed));
   demo->add_option("--stair-height", o.stair_height, "m, step height (0 = drawn from the seed)")
       ->check(cli::finite_in(0, kMaxStairHeight));
   demo->add_option("--obstacles", o.obstacles, "K obstacles (-1 = scene default)")->check(cli::whole_in(-1, 50));
   demo->add_option("--variant", o.variant, "standard | mixed");
   demo->add_option("--shed-to", o.shed_to, "after the stairs, shed tail modules down to this many (0 = keep)")
-      ->check(cli::whole_in(0, 10));
+      ->check(cli::whole_in(0, kMaxModules));
   demo->add_option("--config-dir", o.config_dir, "directory of robot/scene/motion/task.yaml");
   demo->callback([] { run_demo(o); });
 }};

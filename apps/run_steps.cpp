@@ -209,7 +209,7 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
     comorph::report::RunInfo info;
     info.name = fs::path(run_dir).filename().string();
     info.kind = config.trainer.mode;
-    info.modules = config.trainer.mode == "fixed" ? config.trainer.fixed_modules : comorph::coopt::kMaxModules;
+    info.modules = config.trainer.mode == "fixed" ? config.trainer.fixed_modules : comorph::kMaxModules;
     info.algo = config.trainer.motion_algo;
     info.scenario = config.trainer.scenario;
     info.episodes = config.trainer.total_episodes();

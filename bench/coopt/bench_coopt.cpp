@@ -30,7 +30,7 @@ int main() {
   int steps = 0;
   auto t0 = Clock::now();
   for (int ep = 0; steps < 3000; ++ep) {
-    env.reset({static_cast<std::uint64_t>(ep), 4, 0, -1, sim::Variant::standard});
+    env.reset({static_cast<std::uint64_t>(ep), make_chain(4), 0, -1, sim::Variant::standard});
     for (int i = 0; i < 500 && !env.done(); ++i, ++steps) {
       for (float& x : a) x = u(rng);
       env.step(a, control::MotionMode::stair);

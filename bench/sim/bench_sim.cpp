@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
     task::MultiTaskEnv env(config);
     task::EpisodeSpec spec;
     spec.seed = 1;
-    spec.modules = n;
+    spec.configuration = make_chain(n);
     spec.stair_height = 0.06;
     // A stair-mode wave up the stairs: contacts with steps, hinges moving.
     const float action[5] = {0.8f, 0.0f, 0.5f, -0.5f, 0.5f};

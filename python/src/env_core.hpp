@@ -53,7 +53,7 @@ class EnvCore {
     seeded_ = true;
     task::EpisodeSpec spec;
     spec.seed = episode_seed_;
-    spec.modules = modules > 0 ? modules : options_.modules;
+    spec.configuration = make_chain(modules > 0 ? modules : options_.modules);
     spec.stair_height = stair_height;
     spec.obstacles = options_.obstacles;
     spec.variant = options_.variant;
@@ -75,7 +75,7 @@ class EnvCore {
     if (modules < kMinModules || modules >= env_.modules())
       throw std::invalid_argument("reconfigure sheds tail modules: modules must be in " + std::to_string(kMinModules) +
                                   ".." + std::to_string(env_.modules() - 1) + ", got " + std::to_string(modules));
-    env_.reconfigure(modules);
+    env_.reconfigure(make_chain(modules));
   }
 
   void require_started(const char* what) const {

@@ -24,11 +24,6 @@
 
 namespace comorph::coopt {
 
-// Candidates of the configuration model: chains of kMinModules..kMaxModules.
-inline constexpr int kMinModules = 2;
-inline constexpr int kMaxModules = 10;
-inline constexpr int kCandidates = kMaxModules - kMinModules + 1;  // 9 Q values
-
 struct TrainerParams {
   std::string mode = "hierarchical";  // hierarchical (DQN picks the chain) | fixed (fixed_modules, no DQN)
   int fixed_modules = 4;              // chain length of the fixed baseline, 2..10

@@ -45,12 +45,19 @@ std::string range_error(const std::string& field, double value, const std::strin
   return fmt::format("{} = {} {}", field, value, rule);
 }
 
+// Empty when chains of min..max modules are ones the simulator builds.
+std::string chain_range_fault(int min_modules, int max_modules) {
+  if (min_modules >= kMinModules && max_modules <= kMaxModules && min_modules <= max_modules) return {};
+  return fmt::format("modules [{}, {}] must be within [{}, {}] with min <= max", min_modules, max_modules,
+                     kMinModules, kMaxModules);
+}
+
 // The episode of one scene seed: chain length, K, variant.
 task::EpisodeSpec draw_spec(std::mt19937_64& rng, std::uint64_t scene_seed, int min_modules, int max_modules,
                             int min_obstacles, int max_obstacles) {
   task::EpisodeSpec spec;
   spec.seed = scene_seed;
-  spec.modules = uniform_int(rng, min_modules, max_modules);
+  spec.configuration = make_chain(uniform_int(rng, min_modules, max_modules));
   spec.obstacles = uniform_int(rng, min_obstacles, max_obstacles);
   spec.variant = sim::Variant::standard;
   spec.stair_height = 0;  // drawn from the scene seed
@@ -115,8 +122,7 @@ std::string SceneDatasetParams::validate() const {
     return p + fmt::format("last_seed {} is below first_seed {}", last_seed, first_seed);
   if (frames_per_seed < 1) return p + range_error("frames_per_seed", frames_per_seed, "must be >= 1");
   if (!(run_fraction >= 0 && run_fraction <= 1)) return p + range_error("run_fraction", run_fraction, "must be in [0, 1]");
-  if (min_modules < 2 || max_modules > 10 || min_modules > max_modules)
-    return p + fmt::format("modules [{}, {}] must be within [2, 10] with min <= max", min_modules, max_modules);
+  if (std::string fault = chain_range_fault(min_modules, max_modules); !fault.empty()) return p + fault;
   if (min_obstacles < 0 || min_obstacles > max_obstacles)
     return p + fmt::format("obstacles [{}, {}] need 0 <= min <= max", min_obstacles, max_obstacles);
   if (!(mixed_fraction >= 0 && mixed_fraction <= 1))
@@ -180,7 +186,7 @@ SceneDatasetStats generate_scene_frames(const task::EnvConfig& config, const Sce
     heads.clear();
     FrameInfo info;
     info.scene_seed = scene_seed;
-    info.modules = spec.modules;
+    info.modules = env.modules();
     info.obstacles = spec.obstacles;
     if (run_quota > 0) {
       task::ScriptedPilot pilot = dataset_pilot();
@@ -336,8 +342,7 @@ std::string format_run_ends(const SceneDatasetStats& st) {
 std::string EpisodeSwitchParams::validate() const {
   const std::string p = "episode switch evaluation: ";
   if (last_seed < first_seed) return p + fmt::format("last_seed {} is below first_seed {}", last_seed, first_seed);
-  if (min_modules < 2 || max_modules > 10 || min_modules > max_modules)
-    return p + fmt::format("modules [{}, {}] must be within [2, 10] with min <= max", min_modules, max_modules);
+  if (std::string fault = chain_range_fault(min_modules, max_modules); !fault.empty()) return p + fault;
   if (min_obstacles < 0 || min_obstacles > max_obstacles)
     return p + fmt::format("obstacles [{}, {}] need 0 <= min <= max", min_obstacles, max_obstacles);
   if (max_steps < 1) return p + range_error("max_steps", max_steps, "must be >= 1");

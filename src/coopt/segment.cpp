@@ -1,20 +1,49 @@
 #include "coopt/segment.hpp"
 
 #include <stdexcept>
-#include <string>
 
 namespace comorph::coopt {
+namespace {
 
-void candidate_mask(int max_modules, std::vector<std::uint8_t>& mask) {
-  if (max_modules < kMinModules || max_modules > kMaxModules)
-    throw std::invalid_argument("candidate_mask: " + std::to_string(max_modules) + " modules is outside [2, 10]");
-  mask.resize(kCandidates);
-  for (int c = 0; c < kCandidates; ++c) mask[c] = modules_of(c) <= max_modules ? 1 : 0;
+using MaskTable = std::array<std::array<std::uint8_t, kCandidates>, kCandidates>;
+
+// table[c][d] = 1 when candidate d is candidate c or one c can shed modules to.
+const MaskTable& mask_table() {
+  static const MaskTable table = [] {
+    MaskTable t{};
+    for (int c = 0; c < kCandidates; ++c)
+      for (int d = 0; d < kCandidates; ++d)
+        t[c][d] = c == d || validate_sub_configuration(candidates()[c], candidates()[d]).empty();
+    return t;
+  }();
+  return table;
 }
 
-std::vector<std::uint8_t> candidate_mask(int max_modules) {
+}  // namespace
+
+const std::array<Configuration, kCandidates>& candidates() {
+  static const std::array<Configuration, kCandidates> chains = [] {
+    std::array<Configuration, kCandidates> c;
+    for (int a = 0; a < kCandidates; ++a) c[a] = make_chain(modules_of(a));
+    return c;
+  }();
+  return chains;
+}
+
+int candidate_index(const Configuration& config) {
+  for (int c = 0; c < kCandidates; ++c)
+    if (candidates()[c] == config) return c;
+  throw std::invalid_argument("the configuration (" + describe(config) + ") is not a candidate of the configuration model");
+}
+
+void candidate_mask(const Configuration& current, std::vector<std::uint8_t>& mask) {
+  const auto& row = mask_table()[candidate_index(current)];
+  mask.assign(row.begin(), row.end());
+}
+
+std::vector<std::uint8_t> candidate_mask(const Configuration& current) {
   std::vector<std::uint8_t> mask;
-  candidate_mask(max_modules, mask);
+  candidate_mask(current, mask);
   return mask;
 }
 

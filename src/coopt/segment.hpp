@@ -1,7 +1,8 @@
 // The configuration model's semi-MDP bookkeeping (paper Algorithm 1), torch-free:
-// - candidate masks: at the episode start every chain of 2..10 modules is
-//   valid; after a choice of C_n modules only [2, C_n] (the robot can only
-//   shed tail modules);
+// - the candidates: the configurations the DQN chooses among, one per action;
+// - candidate masks: a candidate is valid when it is the current configuration
+//   or one the robot can shed modules to (at the episode start the current
+//   configuration is the longest chain, so every candidate is valid);
 // - the segment a decision governs: its summed R1, its length k in control
 //   steps, whether it started before the stairs were climbed, whether the r_s
 //   event happened in it, and the stair energy E_c spent during it -> R2 (Eq. 7).
@@ -12,17 +13,25 @@
 #include <vector>
 
 #include "coopt/config.hpp"
+#include "morphology/configuration.hpp"
 #include "task/rewards.hpp"
 
 namespace comorph::coopt {
 
-// Candidate index <-> modules (index 0 = 2 modules ... 8 = 10 modules).
+// The candidates, by action index: action a is the chain of a + kMinModules
+// modules (index 0 = 2 modules ... 8 = 10 modules).
+inline constexpr int kCandidates = kMaxModules - kMinModules + 1;  // 9 Q values
+const std::array<Configuration, kCandidates>& candidates();
 inline int modules_of(int candidate) { return candidate + kMinModules; }
 inline int candidate_of(int modules) { return modules - kMinModules; }
 
-// Valid-action mask over the 9 candidates: 1 for chains of 2..max_modules.
-std::vector<std::uint8_t> candidate_mask(int max_modules);
-void candidate_mask(int max_modules, std::vector<std::uint8_t>& mask);  // no allocation once sized
+// The action index of a candidate; throws std::invalid_argument for another configuration.
+int candidate_index(const Configuration& config);
+
+// Valid-action mask over the candidates: 1 for `current` (a candidate) and for
+// each candidate morphology accepts as a sub-configuration of it.
+std::vector<std::uint8_t> candidate_mask(const Configuration& current);
+void candidate_mask(const Configuration& current, std::vector<std::uint8_t>& mask);  // no allocation once sized
 
 // One configuration decision's segment.
 class Segment {

@@ -220,24 +220,25 @@ void fill_motion(const task::MultiTaskEnv& env, const TrainerParams& t, rl::Obse
   fill_motion(env.depth(), env.state(), env.clearance(), t, o);
 }
 
-// The configuration model's vector [C_n / 10, scene one-hot] and mask; the image is already in o.image.
-void fill_config_vector(const TrainerParams& t, int max_modules, int scene, Buffers& b, rl::Observation& o) {
+// The configuration model's vector [C_n / 10, scene one-hot] and mask (the current
+// configuration and those it can shed modules to); the image is already in o.image.
+void fill_config_vector(const TrainerParams& t, const Configuration& current, int scene, Buffers& b,
+                        rl::Observation& o) {
   const bool vector = t.config_vector;
   if (vector) {
-    o.vector[0] = static_cast<float>(max_modules) / kMaxModules;
+    o.vector[0] = static_cast<float>(modules_of(candidate_index(current))) / kMaxModules;
     for (int k = 0; k < 3; ++k) o.vector[1 + k] = scene == k ? 1.0f : 0.0f;
   }
-  candidate_mask(max_modules, b.mask);
+  candidate_mask(current, b.mask);
   o.valid_actions = b.mask;
 }
 
-void fill_config(const task::MultiTaskEnv& env, const TrainerParams& t, int max_modules, int scene, Buffers& b,
-                 rl::Observation& o) {
+void fill_config(const task::MultiTaskEnv& env, const TrainerParams& t, int scene, Buffers& b, rl::Observation& o) {
   if (t.decision_camera)
     env.render_decision_depth(o.image.data());
   else
     std::copy(env.depth(), env.depth() + o.image.size(), o.image.begin());
-  fill_config_vector(t, max_modules, scene, b, o);
+  fill_config_vector(t, env.configuration(), scene, b, o);
 }
 
 control::MotionMode mode_of(int scene) {
@@ -252,37 +253,38 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
   EpisodeLog log;
   const bool hierarchical = agent.config != nullptr;
   const TrainerParams& t = c.trainer;
-  int modules = c.trainer.fixed_modules;
+  Configuration configuration = make_chain(c.trainer.fixed_modules);
   double return_r2 = 0;
   Laps* laps = hooks ? hooks->laps : nullptr;
   auto lap = [laps](Phase p) {
     if (laps) laps->lap(p);
   };
   lap(kOther);
-  auto choose = [&](rl::Observation& o) {
+  auto choose = [&](rl::Observation& o) -> const Configuration& {
     int a = hooks && hooks->random_config ? hooks->random_config(b.mask) : -1;
     if (a < 0) {
       agent.config->act(o, explore, b.caction);
       a = b.caction.discrete;
     }
     b.caction.discrete = a;
-    return modules_of(a);
+    return candidates()[a];
   };
 
   // 1. The first configuration decision, on the first depth image (module 1's
   //    camera does not depend on the chain behind it).
   if (hierarchical) {
-    spec.modules = kMaxModules;
+    spec.configuration = make_chain(kMaxModules);
     env.reset(spec);
     lap(kEnvReset);
     scene.reset(env);
     lap(kClassifier);
-    fill_config(env, t, kMaxModules, scene.current(), b, b.cobs);
-    modules = choose(b.cobs);
+    fill_config(env, t, scene.current(), b, b.cobs);
+    configuration = choose(b.cobs);
     lap(kDqn);
   }
-  spec.modules = modules;
+  spec.configuration = configuration;
   env.reset(spec);
+  int modules = env.modules();
   lap(kEnvReset);
   scene.reset(env);
   lap(kClassifier);
@@ -336,14 +338,14 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
     //    new decision among [2, C_n].
     const double r2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
     return_r2 += r2;
-    fill_config(env, t, modules, scene.current(), b, b.cnext);
+    fill_config(env, t, scene.current(), b, b.cnext);
     if (hooks) hooks->config(b.cobs, b.caction, static_cast<float>(r2), b.cnext, false, false, segment.steps());
     std::swap(b.cobs, b.cnext);
-    const int next_modules = choose(b.cobs);
+    const Configuration& next = choose(b.cobs);
     lap(kDqn);
-    if (next_modules < modules) {
-      env.reconfigure(next_modules);
-      modules = next_modules;
+    if (next != env.configuration()) {
+      env.reconfigure(next);
+      modules = env.modules();
       lap(kEnvReset);
       fill_motion(env, t, b.obs);
     }
@@ -355,7 +357,7 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
   if (hierarchical) {
     const double r2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
     return_r2 += r2;
-    fill_config(env, t, modules, scene.current(), b, b.cnext);
+    fill_config(env, t, scene.current(), b, b.cnext);
     if (hooks)
       hooks->config(b.cobs, b.caction, static_cast<float>(r2), b.cnext, r->terminated, r->truncated, segment.steps());
     lap(kDqn);
@@ -1233,7 +1235,7 @@ int GreedyPolicy::choose_modules(const float* image, int max_modules, int scene)
   if (scene < 0 || scene > 2) throw std::invalid_argument("scene must be 0, 1 or 2, got " + std::to_string(scene));
   Buffers& b = impl_->buffers;
   std::copy(image, image + b.cobs.image.size(), b.cobs.image.begin());
-  fill_config_vector(impl_->config.trainer, max_modules, scene, b, b.cobs);
+  fill_config_vector(impl_->config.trainer, candidates()[candidate_of(max_modules)], scene, b, b.cobs);
   impl_->agent.config->act(b.cobs, false, b.caction);
   return modules_of(b.caction.discrete);
 }

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "common/yaml_fields.hpp"  // load_yaml_file, write_file_atomic
+#include "morphology/configuration.hpp"
 
 namespace fs = std::filesystem;
 
@@ -38,8 +39,9 @@ RunInfo read_run_info(const std::string& path, const std::string& default_name) 
   if (info.kind != "hierarchical" && info.kind != "fixed")
     throw std::runtime_error(fmt::format("{}: kind '{}' is not hierarchical or fixed", path, info.kind));
   info.modules = integer("modules");
-  if (info.kind == "fixed" && (info.modules < 2 || info.modules > 10))
-    throw std::runtime_error(fmt::format("{}: a fixed run needs modules in 2..10 (got {})", path, info.modules));
+  if (info.kind == "fixed" && (info.modules < kMinModules || info.modules > kMaxModules))
+    throw std::runtime_error(fmt::format("{}: a fixed run needs modules in {}..{} (got {})", path, kMinModules,
+                                         kMaxModules, info.modules));
   info.algo = text("algo", true, "");
   if (info.algo != "td3" && info.algo != "sac")
     throw std::runtime_error(fmt::format("{}: algo '{}' is not td3 or sac", path, info.algo));

@@ -26,10 +26,10 @@ struct ModuleGeometry {
 const char* kRobotGeom = "contype=\"2\" conaffinity=\"1\" group=\"1\"";
 const char* kSceneGeom = "contype=\"1\" conaffinity=\"2\" group=\"0\"";
 
-void write_module(std::string& out, int k, int n, const RobotParams& p, const ModuleGeometry& g,
-                  int depth) {
+// Module `id` (1-based) and, nested in its back plate, the module docked there.
+void write_module(std::string& out, const Configuration& config, int id, const RobotParams& p,
+                  const ModuleGeometry& g, int depth) {
   const std::string ind(2 * depth, ' ');
-  const int id = k + 1;
   // Wheels: spheres (fast analytic contacts with planes and box edges).
   for (const char* side : {"l", "r"}) {
     const double y = side[0] == 'l' ? p.wheel_offset_y : -p.wheel_offset_y;
@@ -44,7 +44,7 @@ void write_module(std::string& out, int k, int n, const RobotParams& p, const Mo
   const std::string hinge_attrs =
       fmt::format("type=\"hinge\" axis=\"0 1 0\" range=\"{:.6g} {:.6g}\" armature=\"{:.6g}\" damping=\"{:.6g}\"",
                   -p.hinge_range, p.hinge_range, p.hinge_armature, p.hinge_damping);
-  if (k == 0) {  // module 1's front plate: never connected, carries the camera side
+  if (id == 1) {  // module 1's front plate: never connected, carries the camera side
     out += fmt::format(
         "{0}<body name=\"front_plate1\" pos=\"{1:.6g} 0 {2:.6g}\">\n"
         "{0}  <joint name=\"front1\" {3}/>\n"
@@ -53,8 +53,11 @@ void write_module(std::string& out, int k, int n, const RobotParams& p, const Mo
         "{0}</body>\n",
         ind, g.hx, g.plate_z, hinge_attrs, 0.5 * g.t, g.hy, g.plate_hz, p.plate_mass, kRobotGeom);
   }
-  // Back plate (and, when connected, the next module's front plate: magnets hold them as one link).
-  const bool connected = k + 1 < n;
+  // Back plate (and, when connected, the docked module's front plate: magnets hold them as one
+  // link). validate() accepts chains only, so only the back face carries a
+  // module; a module type with more faces would nest its other docked modules here too.
+  const int docked = module_at_face(config, id, kBackFace);
+  const bool connected = docked != 0;
   const double link_half = connected ? g.t : 0.5 * g.t;
   out += fmt::format(
       "{0}<body name=\"link{1}\" pos=\"{2:.6g} 0 {3:.6g}\">\n"
@@ -64,7 +67,7 @@ void write_module(std::string& out, int k, int n, const RobotParams& p, const Mo
       ind, id, -g.hx, g.plate_z, hinge_attrs, -link_half, link_half, g.hy, g.plate_hz,
       connected ? 2 * p.plate_mass : p.plate_mass, kRobotGeom);
   if (connected) {
-    const int nid = id + 1;
+    const int nid = docked;
     out += fmt::format(
         "{0}  <body name=\"module{1}\" pos=\"{2:.6g} 0 {3:.6g}\">\n"
         "{0}    <joint name=\"front{1}\" pos=\"{4:.6g} 0 {5:.6g}\" {6}/>\n"
@@ -72,7 +75,7 @@ void write_module(std::string& out, int k, int n, const RobotParams& p, const Mo
         "mass=\"{11:.6g}\" rgba=\"0.2 0.4 0.8 1\" {12}/>\n",
         ind, nid, -(g.hx + 2 * g.t), -g.plate_z, g.hx, g.plate_z, hinge_attrs, g.body_z, g.hx, g.hy,
         g.body_hz, p.body_mass, kRobotGeom);
-    write_module(out, k + 1, n, p, g, depth + 2);
+    write_module(out, config, docked, p, g, depth + 2);
     out += ind + "  </body>\n";
   }
   out += ind + "</body>\n";
@@ -87,8 +90,11 @@ std::string box_geom(const std::string& name, const Box& b, const char* rgba, co
 
 }  // namespace
 
-std::string build_mjcf(int n, const RobotParams& p, const SceneParams& sp, const SceneLayout& s) {
-  if (n < 2 || n > 10) throw std::invalid_argument("modules must be in 2..10, got " + std::to_string(n));
+std::string build_mjcf(const Configuration& config, const RobotParams& p, const SceneParams& sp,
+                       const SceneLayout& s) {
+  if (std::string fault = validate(config); !fault.empty())
+    throw std::invalid_argument("the simulator cannot build this configuration: " + fault);
+  const int n = module_count(config);
   const ModuleGeometry g(p);
   std::string out;
   out += fmt::format(
@@ -145,7 +151,7 @@ std::string build_mjcf(int n, const RobotParams& p, const SceneParams& sp, const
       g.body_z, g.hx, g.hy, g.body_hz, p.body_mass, kRobotGeom, 0.5 * p.module_length,
       p.camera_height - p.wheel_radius, std::sin(p.depth_pitch), std::cos(p.depth_pitch),
       p.depth_fov_y * 180.0 / M_PI);
-  write_module(out, 0, n, p, g, 3);
+  write_module(out, config, 1, p, g, 3);
   out += "    </body>\n  </worldbody>\n  <actuator>\n";
   for (int k = 1; k <= n; ++k) {
     for (const char* side : {"l", "r"})

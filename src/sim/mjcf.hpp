@@ -1,4 +1,5 @@
-// MJCF of the robot chain and the scene. The chain is a kinematic tree:
+// MJCF of the robot and the scene, built from the robot's configuration
+// (a Configuration of src/morphology), never from a count. The chain is a kinematic tree:
 // module 1 has the free joint; module k+1 hangs from module k through two
 // pitch hinges (module k's back plate "back<k>" and module k+1's front plate
 // "front<k+1>"). Body/joint order makes the state of modules 1..M a prefix of
@@ -14,6 +15,7 @@
 
 #include <string>
 
+#include "morphology/configuration.hpp"
 #include "sim/params.hpp"
 #include "sim/scene.hpp"
 
@@ -23,10 +25,11 @@ inline constexpr int kJointsPerModule = 4;     // wheel_l, wheel_r, front, back
 inline constexpr int kActuatorsPerModule = 4;  // same order as below
 enum ModuleActuator : int { kWheelLeft = 0, kWheelRight = 1, kFrontHinge = 2, kBackHinge = 3 };
 
-// The whole scene with a chain of `modules` modules standing at the layout's start.
+// The whole scene with the robot `config` describes standing at the layout's start.
 // All params.max_obstacles obstacle slots are written; slots beyond the layout's
-// K are parked far below the floor (group 5, no contact).
-std::string build_mjcf(int modules, const RobotParams& robot, const SceneParams& scene,
+// K are parked far below the floor (group 5, no contact). Throws
+// std::invalid_argument naming the fault when morphology rejects `config`.
+std::string build_mjcf(const Configuration& config, const RobotParams& robot, const SceneParams& scene,
                        const SceneLayout& layout);
 
 // qpos index of the first joint of module k (0-based) after the 7 root coordinates.

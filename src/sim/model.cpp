@@ -1,5 +1,7 @@
 #include "sim/model.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -74,16 +76,34 @@ void apply_layout(mjModel* m, const SceneParams& sp, const SceneLayout& s) {
 ModelCache::ModelCache(const RobotParams& robot, const SceneParams& scene)
     : robot_(robot), scene_(scene) {}
 
-const mjModel* ModelCache::get(int modules) {
-  if (modules < 2 || modules > 10) throw std::invalid_argument("modules must be in 2..10");
+const mjModel* ModelCache::get(const Configuration& config) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!models_[modules]) {
-    // Compiled with a neutral scene (seed 0, no obstacles); apply_layout sets the episode's.
-    const SceneLayout neutral = generate_scene(scene_, 0, scene_.stair_height_a, 0);
-    models_[modules] = compile_mjcf(build_mjcf(modules, robot_, scene_, neutral));
-    ++compilations_;
+  for (const Entry& e : models_)
+    if (e.config == config) return e.model.get();
+  // Compiled with a neutral scene (seed 0, no obstacles); apply_layout sets the episode's.
+  const SceneLayout neutral = generate_scene(scene_, 0, scene_.stair_height_a, 0);
+  models_.push_back({config, compile_mjcf(build_mjcf(config, robot_, scene_, neutral))});
+  ++compilations_;
+  return models_.back().model.get();
+}
+
+std::string model_fault(const mjModel* m, const Configuration& config) {
+  if (std::string fault = validate(config); !fault.empty()) return "invalid configuration: " + fault;
+  const int n = module_count(config);
+  if (m->nu != kActuatorsPerModule * n)
+    return fmt::format("{} actuators for {} modules (expected {} per module)", m->nu, n, kActuatorsPerModule);
+  for (int module = 1; module <= n; ++module) {
+    const int body = mj_name2id(m, mjOBJ_BODY, ("module" + std::to_string(module)).c_str());
+    if (body < 0) return fmt::format("module {} has no body", module);
+    const int docked = module_at_face(config, module, kBackFace);
+    if (!docked) continue;
+    // The docked module hangs from this module's back-plate link.
+    const int link = mj_name2id(m, mjOBJ_BODY, ("link" + std::to_string(module)).c_str());
+    const int child = mj_name2id(m, mjOBJ_BODY, ("module" + std::to_string(docked)).c_str());
+    if (link < 0 || m->body_parentid[link] != body || child < 0 || m->body_parentid[child] != link)
+      return fmt::format("module {} does not hang from module {}'s back plate", docked, module);
   }
-  return models_[modules].get();
+  return {};
 }
 
 namespace {

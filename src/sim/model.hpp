@@ -1,15 +1,16 @@
-// Compiling MJCF and caching compiled models per chain length. The scene part
+// Compiling MJCF and caching compiled models per configuration. The scene part
 // of a cached model is a set of slots (steps, obstacles, target) that
 // apply_layout() rewrites per episode, so a new seed never recompiles.
 #pragma once
 
 #include <mujoco/mujoco.h>
 
-#include <array>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
+#include "morphology/configuration.hpp"
 #include "sim/params.hpp"
 #include "sim/scene.hpp"
 
@@ -33,19 +34,30 @@ ModelPtr compile_mjcf(const std::string& xml);
 // obstacle slots parked, target position. Does not touch the robot.
 void apply_layout(mjModel* m, const SceneParams& scene, const SceneLayout& layout);
 
-// Compiled models for chains of 2..10 modules, compiled on first request and
-// kept for the process (thread-safe). Each caller copies the model it mutates.
+// Empty when the compiled model `m` is the robot `config` describes (a body
+// per module, each docked module hanging from the back plate it docks to,
+// kActuatorsPerModule actuators per module); otherwise names the first difference.
+std::string model_fault(const mjModel* m, const Configuration& config);
+
+// Compiled models keyed by configuration, compiled on first request and kept
+// for the process (thread-safe). Each caller copies the model it mutates.
 class ModelCache {
  public:
   ModelCache(const RobotParams& robot, const SceneParams& scene);
-  const mjModel* get(int modules);  // compiles once per module count
+  // Compiles once per configuration; throws std::invalid_argument for one
+  // morphology rejects.
+  const mjModel* get(const Configuration& config);
   int compilations() const { return compilations_; }
 
  private:
+  struct Entry {
+    Configuration config;
+    ModelPtr model;
+  };
   RobotParams robot_;
   SceneParams scene_;
   std::mutex mutex_;
-  std::array<ModelPtr, 11> models_;
+  std::vector<Entry> models_;  // a few configurations: a linear search is enough
   int compilations_ = 0;
 };
 

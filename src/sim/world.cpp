@@ -10,17 +10,6 @@
 
 namespace comorph::sim {
 
-const char* instability_name(Instability i) {
-  switch (i) {
-    case Instability::none: return "none";
-    case Instability::nan_state: return "nan_state";
-    case Instability::bad_qacc: return "bad_qacc";
-    case Instability::bad_qpos: return "bad_qpos";
-    case Instability::bad_qvel: return "bad_qvel";
-  }
-  return "?";
-}
-
 World::World(const RobotParams& robot, const SceneParams& scene, std::shared_ptr<ModelCache> cache)
     : robot_(robot), scene_(scene), cache_(std::move(cache)) {
   install_quiet_mujoco_warnings();
@@ -69,44 +58,45 @@ World::RaySet World::make_rays(int w, int h, double fov_x, double fov_y, double 
   return r;
 }
 
-World::PerChain& World::chain(int modules) {
-  if (modules < 2 || modules > kMaxChain)
-    throw std::invalid_argument("modules must be in 2..10, got " + std::to_string(modules));
-  auto& slot = chains_[modules];
-  if (!slot) {
-    slot = std::make_unique<PerChain>();
-    slot->model.reset(mj_copyModel(nullptr, cache_->get(modules)));
-    slot->data.reset(mj_makeData(slot->model.get()));
-    for (int k = 0; k < modules; ++k) {
-      const std::string name = "module" + std::to_string(k + 1);
-      slot->module_body[k] = mj_name2id(slot->model.get(), mjOBJ_BODY, name.c_str());
-    }
+World::Body& World::body(const Configuration& config) {
+  for (const auto& b : bodies_)
+    if (b->configuration == config) return *b;
+  auto b = std::make_unique<Body>();
+  b->configuration = config;
+  b->model.reset(mj_copyModel(nullptr, cache_->get(config)));  // throws for an invalid config
+  b->modules = module_count(config);
+  b->data.reset(mj_makeData(b->model.get()));
+  for (int k = 0; k < b->modules; ++k) {
+    const std::string name = "module" + std::to_string(k + 1);
+    b->module_body[k] = mj_name2id(b->model.get(), mjOBJ_BODY, name.c_str());
   }
-  return *slot;
+  bodies_.push_back(std::move(b));
+  return *bodies_.back();
 }
 
-void World::bind(int modules) {
-  PerChain& c = chain(modules);
-  if (!layout_applied_[modules]) {
-    apply_layout(c.model.get(), scene_, layout_);
-    layout_applied_[modules] = true;
+void World::bind(const Configuration& config) {
+  Body& b = body(config);
+  if (!b.layout_applied) {
+    apply_layout(b.model.get(), scene_, layout_);
+    b.layout_applied = true;
   }
-  modules_ = modules;
-  model_ = c.model.get();
-  data_ = c.data.get();
-  module_body_ = c.module_body;
+  body_ = &b;
+  modules_ = b.modules;
+  model_ = b.model.get();
+  data_ = b.data.get();
+  module_body_ = b.module_body;
   first_obstacle_geom_ = mj_name2id(model_, mjOBJ_GEOM, "obstacle0");
   first_step_geom_ = mj_name2id(model_, mjOBJ_GEOM, "step1");
   target_geom_ = mj_name2id(model_, mjOBJ_GEOM, "target");
   floor_geom_ = mj_name2id(model_, mjOBJ_GEOM, "floor");
 }
 
-void World::reset(const SceneLayout& layout, int modules) {
+void World::reset(const SceneLayout& layout, const Configuration& config) {
   if (int(layout.steps.size()) != scene_.steps)
     throw std::invalid_argument("layout does not match SceneParams::steps");
   layout_ = layout;
-  layout_applied_.fill(false);
-  bind(modules);
+  for (const auto& b : bodies_) b->layout_applied = false;
+  bind(config);
   mj_resetData(model_, data_);
   // Module 1's axle centre half a module behind the start face, standing on its wheels.
   const double L = robot_.module_length, yaw = layout_.start_yaw;
@@ -171,22 +161,22 @@ PhysicsStepInfo World::step_control(const double* ctrl) {
   return info;
 }
 
-void World::reconfigure(int modules) {
-  if (modules >= modules_ || modules < 2)
-    throw std::invalid_argument("reconfigure may only shed tail modules: " + std::to_string(modules_) +
-                                " -> " + std::to_string(modules) + " is not allowed");
+void World::reconfigure(const Configuration& part) {
+  if (std::string fault = validate_sub_configuration(configuration(), part); !fault.empty())
+    throw std::invalid_argument("reconfigure: " + fault);
   const mjData* old_d = data_;
   const int old_n = modules_;
-  bind(modules);
+  bind(part);
   mj_resetData(model_, data_);
   data_->time = old_d->time;
-  // The kept modules' coordinates are a prefix of the longer chain's (mjcf.hpp).
+  // The kept modules' coordinates are a prefix of the longer chain's (mjcf.hpp):
+  // a chain's sub-configurations keep modules 1..k.
   std::memcpy(data_->qpos, old_d->qpos, sizeof(double) * model_->nq);
   std::memcpy(data_->qvel, old_d->qvel, sizeof(double) * model_->nv);
   std::memcpy(data_->qacc_warmstart, old_d->qacc_warmstart, sizeof(double) * model_->nv);
   std::memcpy(data_->ctrl, old_d->ctrl, sizeof(double) * model_->nu);
   std::memcpy(data_->warning, old_d->warning, sizeof(data_->warning));
-  for (int k = modules; k < old_n; ++k) {
+  for (int k = modules_; k < old_n; ++k) {
     shed_energy_ += energy_[k];
     energy_[k] = 0;
   }

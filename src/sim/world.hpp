@@ -1,8 +1,8 @@
-// The simulated world of one episode: a chain of N modules in a seeded scene.
-// Read-only compiled models come from a ModelCache; the World keeps its own
-// copy per chain length (the scene written into it at reset) and one mjData
-// per chain length, so reset() and reconfigure() never recompile and the
-// control step never allocates.
+// The simulated world of one episode: the robot of a configuration in a seeded
+// scene. Read-only compiled models come from a ModelCache; the World keeps its
+// own copy per configuration (the scene written into it at reset) and one
+// mjData per configuration, so reset() and reconfigure() never recompile and
+// the control step never allocates.
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -11,13 +11,12 @@
 #include <memory>
 #include <vector>
 
+#include "morphology/configuration.hpp"
 #include "sim/model.hpp"
 #include "sim/params.hpp"
 #include "sim/scene.hpp"
 
 namespace comorph::sim {
-
-inline constexpr int kMaxChain = 10;
 
 // Why the physics was declared unstable (0 = stable).
 enum class Instability { none, nan_state, bad_qacc, bad_qpos, bad_qvel };
@@ -34,18 +33,21 @@ class World {
  public:
   World(const RobotParams& robot, const SceneParams& scene, std::shared_ptr<ModelCache> cache = nullptr);
 
-  // New episode: writes the layout into the model for `modules`, puts the chain
-  // at the layout's start pose at rest, refills the batteries.
-  void reset(const SceneLayout& layout, int modules);
+  // New episode: writes the layout into the model of `config`, puts the robot
+  // at the layout's start pose at rest, refills the batteries. Throws
+  // std::invalid_argument for a configuration morphology rejects.
+  void reset(const SceneLayout& layout, const Configuration& config);
 
   // Runs control_period / physics_timestep mj_step calls with `ctrl` held
   // (kActuatorsPerModule values per module, see mjcf.hpp), accounting energy,
   // contacts and instability. Stops early when the physics becomes unstable.
   PhysicsStepInfo step_control(const double* ctrl);
 
-  // Sheds tail modules: switches to the cached model with `modules` < modules()
-  // and copies time, the kept modules' qpos, qvel, ctrl and warm start exactly.
-  void reconfigure(int modules);
+  // Sheds modules: switches to the cached model of `part`, which must be a
+  // sub-configuration of configuration() (validate_sub_configuration; throws
+  // std::invalid_argument naming the fault otherwise), and copies time, the kept
+  // modules' qpos, qvel, ctrl and warm start exactly.
+  void reconfigure(const Configuration& part);
 
   // ---- sensors (scene geoms only: the robot never occludes itself) ----
   // Depth image from module 1's camera, row-major depth_height x depth_width,
@@ -78,6 +80,7 @@ class World {
 
   // ---- state ----
   int modules() const { return modules_; }
+  const Configuration& configuration() const { return body_->configuration; }
   const mjModel* model() const { return model_; }
   const mjData* data() const { return data_; }
   mjData* mutable_data() { return data_; }  // for tests and tools; not for the env hot path
@@ -95,16 +98,18 @@ class World {
   double battery_fraction(int k) const;                           // remaining, 0..1
   int substeps() const { return substeps_; }
   int compilations() const { return cache_->compilations(); }
-  int body_of_module(int k) const { return module_body_[k]; }
 
  private:
-  struct PerChain {  // one per module count, made on first use
+  struct Body {  // one per configuration, made on first use
+    Configuration configuration;
+    int modules = 0;
     ModelPtr model;
     DataPtr data;
-    std::array<int, kMaxChain> module_body{};
+    std::array<int, kMaxModules> module_body{};
+    bool layout_applied = false;  // the scene of the last reset() is written into `model`
   };
-  PerChain& chain(int modules);
-  void bind(int modules);
+  Body& body(const Configuration& config);
+  void bind(const Configuration& config);
   double ray_scene(const double pnt[3], const double dir[3], double max_dist) const;
   // Pinhole ray grid of one camera, in the camera-carrier frame (x forward, y left, z up).
   struct RaySet {
@@ -119,22 +124,20 @@ class World {
   RobotParams robot_;
   SceneParams scene_;
   std::shared_ptr<ModelCache> cache_;
-  std::array<std::unique_ptr<PerChain>, kMaxChain + 1> chains_;
-  std::array<bool, kMaxChain + 1> layout_applied_{};
+  std::vector<std::unique_ptr<Body>> bodies_;
+  Body* body_ = nullptr;  // the current configuration's
   SceneLayout layout_;
   int modules_ = 0;
   mjModel* model_ = nullptr;
   mjData* data_ = nullptr;
-  std::array<int, kMaxChain> module_body_{};
+  std::array<int, kMaxModules> module_body_{};
   int substeps_ = 16;
   int first_obstacle_geom_ = -1, first_step_geom_ = -1, target_geom_ = -1, floor_geom_ = -1;
-  std::array<double, kMaxChain> energy_{};
+  std::array<double, kMaxModules> energy_{};
   double shed_energy_ = 0;  // J drawn by modules that were shed
   RaySet rays_;           // the motion camera (depth_*)
   RaySet decision_rays_;  // the decision camera (decision_*)
   RaySet scan_rays_;      // the obstacle scan (scan_*), empty when scan_columns = 0
 };
-
-const char* instability_name(Instability i);
 
 }  // namespace comorph::sim

@@ -43,8 +43,8 @@ MultiTaskEnv::MultiTaskEnv(const EnvConfig& config, std::shared_ptr<sim::ModelCa
 void MultiTaskEnv::reset(const EpisodeSpec& spec) {
   const sim::SceneLayout layout =
       sim::generate_scene(config_.scene, spec.seed, spec.stair_height, spec.obstacles, spec.variant);
-  world_.reset(layout, spec.modules);
-  initial_modules_ = spec.modules;
+  world_.reset(layout, spec.configuration);
+  initial_modules_ = world_.modules();
   steps_ = 0;
   climbed_step_ = -1;
   done_ = false;
@@ -177,9 +177,9 @@ const StepResult& MultiTaskEnv::step(const float* action, control::MotionMode mo
   return result_;
 }
 
-void MultiTaskEnv::reconfigure(int modules) {
+void MultiTaskEnv::reconfigure(const Configuration& part) {
   if (done_) throw std::logic_error("MultiTaskEnv::reconfigure after the episode ended");
-  world_.reconfigure(modules);
+  world_.reconfigure(part);
   on_stairs_ = any_module_on_stairs();
   update_observation();
 }
@@ -210,7 +210,7 @@ void MultiTaskEnv::update_observation() {
   s[obs::kVelocity + 1] = float(world_.data()->qvel[1]);
   s[obs::kPrevReward] = float(result_.reward);
   for (int i = 0; i < control::kActionSize; ++i) s[obs::kPrevAction + i] = prev_action_[i];
-  for (int k = 0; k < sim::kMaxChain; ++k) {
+  for (int k = 0; k < kMaxModules; ++k) {
     const bool present = k < n;
     s[obs::kDistances + 2 * k] = present ? distances_[2 * k] : 0.0f;
     s[obs::kDistances + 2 * k + 1] = present ? distances_[2 * k + 1] : 0.0f;

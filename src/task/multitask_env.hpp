@@ -6,7 +6,7 @@
 // Per control step (32 ms): action (5 floats in [-1, 1]) + motion mode ->
 // Eq. 4/5 motor commands -> 16 x mj_step -> sensors, termination, R1.
 // The hot path does not allocate; reset() and reconfigure() never recompile
-// (models are compiled once per chain length and cached).
+// (models are compiled once per configuration and cached).
 #pragma once
 
 #include <array>
@@ -16,6 +16,7 @@
 
 #include "control/motion_modes.hpp"
 #include "morphology/configuration.hpp"
+#include "sim/mjcf.hpp"
 #include "sim/scene.hpp"
 #include "sim/world.hpp"
 #include "task/env_config.hpp"
@@ -36,7 +37,7 @@ const char* termination_name(Termination t);
 
 struct EpisodeSpec {
   std::uint64_t seed = 0;    // draws the scene (stair height, obstacles, target, start noise)
-  int modules = 4;           // chain length 2..10
+  Configuration configuration = make_chain(4);  // the robot; the controller drives chains only
   double stair_height = 0;   // m; <= 0 draws it from the seed
   int obstacles = -1;        // K; < 0 takes SceneParams::obstacles
   sim::Variant variant = sim::Variant::standard;
@@ -77,7 +78,7 @@ inline constexpr int kPrevAction = 7;    // 5: previous action
 inline constexpr int kDistances = 12;    // 20: left, right distance of module k at 12 + 2k (0..1 of range)
 inline constexpr int kModuleMask = 32;   // 10: 1 for modules present
 inline constexpr int kGoal = 42;         // 3: cos, sin of the goal bearing relative to the heading; distance (m)
-inline constexpr int kMode = 45;         // 1: motion mode of the last step (0 flat, 1 stair, 2 narrow)
+inline constexpr int kMode = 45;         // 1: motion mode of the last step (0 flat, 1 stair)
 inline constexpr int kStateSize = 46;
 }  // namespace obs
 
@@ -96,7 +97,7 @@ struct EnvSpec {
   int action_size = control::kActionSize;  // step(): action_size floats in [action_low, action_high]
   float action_low = -1.0f;
   float action_high = 1.0f;
-  int min_modules = kMinModules;     // EpisodeSpec::modules and reconfigure() range
+  int min_modules = kMinModules;     // chain lengths of EpisodeSpec::configuration and reconfigure()
   int max_modules = kMaxModules;
 };
 
@@ -113,8 +114,9 @@ class MultiTaskEnv {
   const StepResult& step(const float* action, control::MotionMode mode);
   // The same with default_mode() (ground truth) for scripted use.
   const StepResult& step(const float* action) { return step(action, default_mode()); }
-  // Sheds tail modules (only to fewer, >= 2); carries the kept modules' state exactly.
-  void reconfigure(int modules);
+  // Sheds modules: `part` must be a sub-configuration of configuration()
+  // (throws std::invalid_argument naming the fault); carries the kept modules' state exactly.
+  void reconfigure(const Configuration& part);
 
   // Ground truth: stair until the whole chain is on the top of the stairs, then flat.
   control::MotionMode default_mode() const;
@@ -148,6 +150,7 @@ class MultiTaskEnv {
   double stairs_energy() const { return stairs_energy_; }   // J drawn while on_stairs (E_c)
   double stair_height() const { return world_.layout().stair_height; }
   int modules() const { return world_.modules(); }
+  const Configuration& configuration() const { return world_.configuration(); }
   int initial_modules() const { return initial_modules_; }
   int step_count() const { return steps_; }
   bool done() const { return done_; }
@@ -169,13 +172,13 @@ class MultiTaskEnv {
   EnvConfig config_;
   sim::World world_;
   control::MotorCommand command_;
-  std::array<double, 4 * sim::kMaxChain> ctrl_{};
+  std::array<double, sim::kActuatorsPerModule * kMaxModules> ctrl_{};
   std::vector<float> depth_;
   std::vector<float> clearance_;
   int horizon_rows_ = 1;  // depth rows whose centre looks above the horizon (level camera)
   std::array<float, obs::kStateSize> state_{};
   std::array<float, control::kActionSize> prev_action_{};
-  std::array<float, 2 * sim::kMaxChain> distances_{};
+  std::array<float, 2 * kMaxModules> distances_{};
   StepResult result_;
   control::MotionMode mode_ = control::MotionMode::flat;
   int initial_modules_ = 0;

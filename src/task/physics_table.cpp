@@ -13,7 +13,7 @@ ClimbTrial run_climb_trial(const EnvConfig& config, int modules, double stair_he
   MultiTaskEnv env(c, std::move(cache));
   EpisodeSpec spec;
   spec.seed = seed;
-  spec.modules = modules;
+  spec.configuration = make_chain(modules);
   spec.stair_height = stair_height;
   spec.obstacles = 0;
   env.reset(spec);
@@ -51,7 +51,7 @@ double measure_turn_rate(const EnvConfig& config, int modules, double seconds,
   const EnvConfig& c = config;
   MultiTaskEnv env(c, std::move(cache));
   EpisodeSpec spec;
-  spec.modules = modules;
+  spec.configuration = make_chain(modules);
   spec.obstacles = 0;
   env.reset(spec);
   const float action[control::kActionSize] = {0.0f, 1.0f, -1.0f, 0.0f, -1.0f};

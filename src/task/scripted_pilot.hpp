@@ -26,7 +26,7 @@ struct PilotParams {
   // Per chain length (index = modules), a gait of its own where set. One gait
   // does not suit every length: the wave lag that climbs with 2, 4 or 6
   // modules stalls 3 modules on the first riser (searched_stair_gaits()).
-  std::array<std::optional<StairGait>, sim::kMaxChain + 1> gait_by_modules{};
+  std::array<std::optional<StairGait>, kMaxModules + 1> gait_by_modules{};
   double heading_gain = 2.5;    // a1 per rad of heading error
   double lookahead = 0.6;       // m along the planned path
   double clearance = 0.40;      // m, obstacles inflated by this when planning

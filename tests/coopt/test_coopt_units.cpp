@@ -13,16 +13,26 @@ namespace {
 const std::string kCi = std::string(COMORPH_SOURCE_DIR) + "/configs/ci.yaml";
 
 TEST(CandidateMask, FirstChoiceAllowsEveryChainThenOnlyFewerModules) {
-  const auto all = candidate_mask(kMaxModules);
+  const auto all = candidate_mask(make_chain(kMaxModules));
   ASSERT_EQ(all.size(), static_cast<std::size_t>(kCandidates));
   for (int c = 0; c < kCandidates; ++c) EXPECT_EQ(all[c], 1) << "candidate " << c;
-  const auto after6 = candidate_mask(6);
+  const auto after6 = candidate_mask(make_chain(6));
   for (int c = 0; c < kCandidates; ++c) EXPECT_EQ(after6[c], modules_of(c) <= 6 ? 1 : 0) << modules_of(c);
-  const auto after2 = candidate_mask(2);
+  const auto after2 = candidate_mask(make_chain(2));
   EXPECT_EQ(after2[candidate_of(2)], 1);
   for (int m = 3; m <= kMaxModules; ++m) EXPECT_EQ(after2[candidate_of(m)], 0) << m;
-  EXPECT_THROW(candidate_mask(1), std::invalid_argument);
-  EXPECT_THROW(candidate_mask(11), std::invalid_argument);
+  Configuration not_a_candidate = make_chain(3);
+  not_a_candidate.C_s[1] = {2, 3, kBackFace, kBackFace, 1};
+  EXPECT_THROW(candidate_mask(not_a_candidate), std::invalid_argument);
+}
+
+// The DQN's action indices stay what they were when the candidates were counts.
+TEST(CandidateMask, ActionIndexIsTheChainLengthMinusTwo) {
+  for (int a = 0; a < kCandidates; ++a) {
+    EXPECT_EQ(candidates()[a], make_chain(a + 2)) << a;
+    EXPECT_EQ(module_count(candidates()[a]), modules_of(a)) << a;
+    EXPECT_EQ(candidate_index(candidates()[a]), a);
+  }
 }
 
 TEST(Segment, StairSegmentAccumulatesR1AndPaysClimbMinusStairEnergy) {

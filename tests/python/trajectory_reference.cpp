@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
   task::MultiTaskEnv env(task::load_env_config(argv[1]));
   task::EpisodeSpec spec;
   spec.seed = std::strtoull(argv[2], nullptr, 10);
-  spec.modules = std::atoi(argv[3]);
+  spec.configuration = make_chain(std::atoi(argv[3]));
   env.reset(spec);
   print_observation(env, 0.0, false, false);
   float a[control::kActionSize];

@@ -2,19 +2,61 @@
 #include <gtest/gtest.h>
 
 #include <set>
+#include <string>
 
 #include "sim/mjcf.hpp"
 #include "sim/model.hpp"
 #include "sim/scene.hpp"
+#include "support/test_support.hpp"
 
 using namespace comorph::sim;
+using comorph::Configuration;
+using comorph::make_chain;
+using comorph::test_support::read_text;
+
+namespace {
+
+// Module 2's back face docked to module 3's back face: valid plates, not a chain.
+Configuration back_to_back_chain() {
+  Configuration c = make_chain(3);
+  c.C_s[1] = {2, 3, comorph::kBackFace, comorph::kBackFace, 1};
+  return c;
+}
+
+}  // namespace
+
+// tests/sim/fixtures/chain_<n>.xml were written by the count-based generator
+// this one replaced, from configs/sim and scene seed 3 with 8 mixed obstacles:
+// the MJCF, and so every run's physics, stays byte for byte the same.
+TEST(Mjcf, ChainIsByteIdenticalToTheCountBasedGenerator) {
+  const std::string source = COMORPH_SOURCE_DIR;
+  const RobotParams rp = load_robot_params(source + "/configs/sim/robot.yaml");
+  const SceneParams sp = load_scene_params(source + "/configs/sim/scene.yaml");
+  const SceneLayout layout = generate_scene(sp, 3, 0, 8, Variant::mixed);
+  for (int n = comorph::kMinModules; n <= comorph::kMaxModules; ++n) {
+    const std::string fixture = read_text(source + "/tests/sim/fixtures/chain_" + std::to_string(n) + ".xml");
+    ASSERT_FALSE(fixture.empty()) << n;
+    EXPECT_EQ(build_mjcf(make_chain(n), rp, sp, layout), fixture) << n << " modules";
+  }
+}
+
+TEST(Mjcf, RefusesAConfigurationMorphologyRejects) {
+  const SceneParams sp;
+  try {
+    build_mjcf(back_to_back_chain(), RobotParams{}, sp, generate_scene(sp, 1));
+    FAIL() << "built a configuration that is not a chain";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("the simulator cannot build this configuration"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("not a chain link"), std::string::npos) << e.what();
+  }
+}
 
 TEST(Mjcf, CompilesForEveryChainLengthWithTheRightCounts) {
   const RobotParams rp;
   const SceneParams sp;
   const SceneLayout layout = generate_scene(sp, 7, 0.06, 6);
   for (int n = 2; n <= 10; ++n) {
-    const ModelPtr m = compile_mjcf(build_mjcf(n, rp, sp, layout));
+    const ModelPtr m = compile_mjcf(build_mjcf(make_chain(n), rp, sp, layout));
     // world + per module (body, 2 wheels, back-plate link) + module 1's free front plate
     EXPECT_EQ(m->nbody, 1 + 4 * n + 1) << n;
     EXPECT_EQ(m->njnt, 1 + 4 * n) << n;
@@ -41,8 +83,8 @@ TEST(Mjcf, StateOfAShorterChainIsAPrefixOfTheLongerOne) {
   const RobotParams rp;
   const SceneParams sp;
   const SceneLayout layout = generate_scene(sp, 1);
-  const ModelPtr big = compile_mjcf(build_mjcf(7, rp, sp, layout));
-  const ModelPtr small = compile_mjcf(build_mjcf(3, rp, sp, layout));
+  const ModelPtr big = compile_mjcf(build_mjcf(make_chain(7), rp, sp, layout));
+  const ModelPtr small = compile_mjcf(build_mjcf(make_chain(3), rp, sp, layout));
   for (int j = 0; j < small->njnt; ++j) {
     const char* name = mj_id2name(small.get(), mjOBJ_JOINT, j);
     const int jb = mj_name2id(big.get(), mjOBJ_JOINT, name);
@@ -58,9 +100,9 @@ TEST(ModelCache, AppliedLayoutEqualsTheExportedScene) {
   ModelCache cache(rp, sp);
   for (std::uint64_t seed : {3u, 11u}) {
     const SceneLayout layout = generate_scene(sp, seed, 0, 8, Variant::mixed);
-    ModelPtr cached(mj_copyModel(nullptr, cache.get(5)));
+    ModelPtr cached(mj_copyModel(nullptr, cache.get(make_chain(5))));
     apply_layout(cached.get(), sp, layout);
-    const ModelPtr exported = compile_mjcf(build_mjcf(5, rp, sp, layout));
+    const ModelPtr exported = compile_mjcf(build_mjcf(make_chain(5), rp, sp, layout));
     ASSERT_EQ(cached->ngeom, exported->ngeom);
     for (int g = 0; g < cached->ngeom; ++g) {
       if (cached->geom_bodyid[g] != 0) continue;  // robot geoms: start pose differs, not the scene
@@ -73,6 +115,23 @@ TEST(ModelCache, AppliedLayoutEqualsTheExportedScene) {
     }
   }
   EXPECT_EQ(cache.compilations(), 1);  // the second seed reused the compiled model
+}
+
+TEST(ModelCache, KeyedByConfigurationAndBuildsWhatItDescribes) {
+  const RobotParams rp;
+  const SceneParams sp;
+  ModelCache cache(rp, sp);
+  const mjModel* four = cache.get(make_chain(4));
+  EXPECT_EQ(cache.get(make_chain(4)), four);
+  const mjModel* five = cache.get(make_chain(5));
+  EXPECT_NE(five, four);
+  EXPECT_EQ(cache.compilations(), 2);
+  EXPECT_EQ(model_fault(four, make_chain(4)), "");
+  EXPECT_EQ(model_fault(five, make_chain(5)), "");
+  EXPECT_NE(model_fault(four, make_chain(5)).find("16 actuators for 5 modules"), std::string::npos);
+  EXPECT_NE(model_fault(four, back_to_back_chain()).find("not a chain link"), std::string::npos);
+  EXPECT_THROW(cache.get(back_to_back_chain()), std::invalid_argument);
+  EXPECT_EQ(cache.compilations(), 2);
 }
 
 TEST(Scene, SameSeedSameSceneDifferentSeedDifferentScene) {

@@ -9,6 +9,7 @@
 #include "sim/world.hpp"
 
 using namespace comorph::sim;
+using comorph::make_chain;
 
 namespace {
 
@@ -43,7 +44,7 @@ TEST(Sensors, DistanceToAKnownObstacle) {
   const double x1 = s.start_x - 0.5 * rp.module_length;  // module 1's centre
   s.obstacles.push_back({x1, 0.60, 0.2, 0.15, 0.15, 0.2});  // left face at y = 0.45
   World w(rp, sp);
-  w.reset(s, 4);
+  w.reset(s, make_chain(4));
   std::vector<float> d(8);
   w.read_distances(d.data());
   EXPECT_NEAR(d[0] * rp.distance_range, 0.45, 1e-4);  // module 1 left
@@ -60,7 +61,7 @@ TEST(Sensors, DepthOfAKnownWall) {
   const double wall_distance = 0.6;  // m from the camera (module 1's front face)
   s.obstacles.push_back({s.start_x + wall_distance + 0.05, 0, 0.5, 0.05, 1.0, 0.5});
   World w(rp, sp);
-  w.reset(s, 3);
+  w.reset(s, make_chain(3));
   std::vector<float> depth(rp.depth_width * rp.depth_height);
   w.render_depth(depth.data());
   const int h = rp.depth_height, wd = rp.depth_width;
@@ -81,7 +82,7 @@ TEST(Sensors, DepthRaysAgreeWithMujocoRayOnSceneGeoms) {
   for (std::uint64_t seed : {2u, 5u}) {
     World w(rp, sp);
     SceneLayout s = generate_scene(sp, seed, 0.08, 8, Variant::mixed);
-    w.reset(s, 5);
+    w.reset(s, make_chain(5));
     // Stand module 1 on the flat area facing the obstacles to see them.
     mjData* d = w.mutable_data();
     d->qpos[0] = s.platform_x + 0.8;
@@ -111,7 +112,7 @@ TEST(Sensors, DepthFromAnArbitraryPoseMatchesTheCamera) {
   const RobotParams rp;
   const SceneParams sp = quiet_scene();
   World w(rp, sp);
-  w.reset(generate_scene(sp, 4), 2);
+  w.reset(generate_scene(sp, 4), make_chain(2));
   const int n = rp.depth_width * rp.depth_height;
   std::vector<float> cam(n), posed(n);
   w.render_depth(cam.data());
@@ -126,7 +127,7 @@ TEST(Energy, IdleDrawOverAKnownTime) {
   const SceneParams sp = quiet_scene();
   World w(rp, sp);
   const int n = 4;
-  w.reset(empty_layout(sp), n);
+  w.reset(empty_layout(sp), make_chain(n));
   const std::vector<double> hold = ctrl_all(n, 0.0, 0.0);
   for (int i = 0; i < 30; ++i) w.step_control(hold.data());  // let it settle
   const double e0 = w.energy_used();
@@ -143,7 +144,7 @@ TEST(Energy, DrivingCostsMoreThanIdling) {
   const RobotParams rp;
   const SceneParams sp = quiet_scene();
   World w(rp, sp);
-  w.reset(empty_layout(sp), 3);
+  w.reset(empty_layout(sp), make_chain(3));
   const std::vector<double> drive = ctrl_all(3, 5.0, 0.0);
   double e = 0;
   for (int i = 0; i < 40; ++i) e += w.step_control(drive.data()).energy_J;
@@ -156,9 +157,9 @@ TEST(Contacts, DrivingIntoAnObstacleIsDetected) {
   const SceneParams sp = quiet_scene();
   SceneLayout s = empty_layout(sp);
   World free_world(rp, sp), blocked_world(rp, sp);
-  free_world.reset(s, 3);
+  free_world.reset(s, make_chain(3));
   s.obstacles.push_back({s.start_x + 0.25, 0, 0.2, 0.15, 0.15, 0.2});  // just ahead, on the ground
-  blocked_world.reset(s, 3);
+  blocked_world.reset(s, make_chain(3));
   const std::vector<double> drive = ctrl_all(3, 5.0, 0.0);
   bool hit_free = false, hit_blocked = false;
   for (int i = 0; i < 60; ++i) {
@@ -173,7 +174,7 @@ TEST(Reconfiguration, KeptModulesCarryTheirStateExactly) {
   const RobotParams rp;
   const SceneParams sp;
   World w(rp, sp);
-  w.reset(generate_scene(sp, 3, 0.06, 0), 6);
+  w.reset(generate_scene(sp, 3, 0.06, 0), make_chain(6));
   std::vector<double> ctrl = ctrl_all(6, 4.0, 0.0);
   for (int i = 0; i < 50; ++i) {
     for (int k = 1; k < 6; ++k) ctrl[4 * k + kFrontHinge] = 0.3 * std::sin(0.2 * i + k);
@@ -189,8 +190,9 @@ TEST(Reconfiguration, KeptModulesCarryTheirStateExactly) {
   const double time = w.time(), used = w.energy_used();
   const int compilations = w.compilations();
 
-  w.reconfigure(3);
+  w.reconfigure(make_chain(3));
   EXPECT_EQ(w.modules(), 3);
+  EXPECT_EQ(w.configuration(), make_chain(3));
   EXPECT_EQ(w.model()->nq, 7 + 4 * 3);
   for (int i = 0; i < w.model()->nq; ++i) EXPECT_EQ(w.data()->qpos[i], qpos[i]) << i;
   for (int i = 0; i < w.model()->nv; ++i) EXPECT_EQ(w.data()->qvel[i], qvel[i]) << i;
@@ -201,18 +203,19 @@ TEST(Reconfiguration, KeptModulesCarryTheirStateExactly) {
   EXPECT_EQ(w.time(), time);
   EXPECT_DOUBLE_EQ(w.energy_used(), used);  // shed modules' energy still counts
   EXPECT_EQ(w.compilations(), compilations + 1);  // the 3-chain model compiled once...
-  w.reset(generate_scene(sp, 4, 0.04, 0), 6);
-  w.reconfigure(3);
+  w.reset(generate_scene(sp, 4, 0.04, 0), make_chain(6));
+  w.reconfigure(make_chain(3));
   EXPECT_EQ(w.compilations(), compilations + 1);  // ...and reused afterwards
-  EXPECT_THROW(w.reconfigure(5), std::invalid_argument);  // only fewer modules
-  EXPECT_THROW(w.reconfigure(1), std::invalid_argument);
+  EXPECT_THROW(w.reconfigure(make_chain(5)), std::invalid_argument);  // only fewer modules
+  EXPECT_THROW(w.reconfigure(make_chain(3)), std::invalid_argument);  // sheds none
+  EXPECT_EQ(w.configuration(), make_chain(3));  // a refused reconfiguration changes nothing
 }
 
 TEST(Stability, NanStateIsReportedNotHidden) {
   const RobotParams rp;
   const SceneParams sp = quiet_scene();
   World w(rp, sp);
-  w.reset(empty_layout(sp), 2);
+  w.reset(empty_layout(sp), make_chain(2));
   const std::vector<double> hold = ctrl_all(2, 0.0, 0.0);
   EXPECT_EQ(w.step_control(hold.data()).instability, Instability::none);
   w.mutable_data()->qvel[0] = std::nan("");
@@ -230,7 +233,7 @@ int rows_that_see_the_height(const RobotParams& rp, bool decision) {
   std::vector<float> low(std::size_t(w) * h), high(low.size());
   World world(rp, sp);
   for (auto [height, out] : {std::pair{0.04, &low}, std::pair{0.08, &high}}) {
-    world.reset(empty_layout(sp, height), 4);
+    world.reset(empty_layout(sp, height), make_chain(4));
     if (decision)
       world.render_decision_depth(out->data());
     else

@@ -24,7 +24,7 @@ struct Lcg {
 task::EpisodeSpec spec(std::uint64_t seed, int modules, double h = 0, int k = -1) {
   task::EpisodeSpec s;
   s.seed = seed;
-  s.modules = modules;
+  s.configuration = make_chain(modules);
   s.stair_height = h;
   s.obstacles = k;
   return s;
@@ -226,14 +226,14 @@ TEST(Env, ReconfigurationMidEpisodeKeepsTheHeadAndUpdatesTheMask) {
   for (int t = 0; t < 80; ++t) env.step(a, control::MotionMode::stair);
   const double x = env.world().module_pos(0)[0], e = env.metrics().energy_J;
   const std::vector<float> dist(env.state() + task::obs::kDistances, env.state() + task::obs::kDistances + 6);
-  env.reconfigure(3);
+  env.reconfigure(make_chain(3));
   EXPECT_EQ(env.modules(), 3);
   EXPECT_EQ(env.initial_modules(), 6);
   EXPECT_EQ(env.world().module_pos(0)[0], x);
   EXPECT_NEAR(env.metrics().energy_J, e, 1e-9);  // shed modules still count (summed in another order)
   for (int k = 0; k < 10; ++k) EXPECT_EQ(env.state()[task::obs::kModuleMask + k], k < 3 ? 1.0f : 0.0f);
   for (int i = 0; i < 6; ++i) EXPECT_EQ(env.state()[task::obs::kDistances + i], dist[i]);
-  EXPECT_THROW(env.reconfigure(4), std::invalid_argument);
+  EXPECT_THROW(env.reconfigure(make_chain(4)), std::invalid_argument);
   for (int t = 0; t < 20; ++t) env.step(a, control::MotionMode::stair);
   EXPECT_GT(env.world().module_pos(0)[0], x);
 }

@@ -34,7 +34,7 @@ TEST_P(HotPath, StepDoesNotAllocate) {
   EXPECT_GT(g_allocations.load(), at_start);  // the counter sees the library's allocations
   task::EpisodeSpec spec;
   spec.seed = 6;
-  spec.modules = 6;
+  spec.configuration = make_chain(6);
   env.reset(spec);
   const float a[5] = {0.8f, 0.1f, 0.5f, -0.5f, 0.5f};
   env.step(a, control::MotionMode::stair);  // warm
