@@ -12,7 +12,6 @@ const char* mode_name(MotionMode m) {
   switch (m) {
     case MotionMode::flat: return "flat";
     case MotionMode::stair: return "stair";
-    case MotionMode::narrow: return "narrow";
   }
   return "?";
 }
@@ -20,8 +19,7 @@ const char* mode_name(MotionMode m) {
 MotionMode parse_mode(const std::string& name) {
   if (name == "flat") return MotionMode::flat;
   if (name == "stair") return MotionMode::stair;
-  if (name == "narrow") return MotionMode::narrow;
-  throw std::invalid_argument("unknown motion mode '" + name + "' (flat, stair, narrow)");
+  throw std::invalid_argument("unknown motion mode '" + name + "' (flat, stair)");
 }
 
 void compute_command(const MotionParams& p, MotionMode mode, const float* action, double t,

@@ -14,19 +14,19 @@
 //         P_i(t) = w3 * A_i * sin(2 pi f t - w4 * B * (i - 2))   (rad)
 //   Module i is in the front half when i - 2 < (N - 1) / 2 (rounded up).
 //   The back-plate hinges and module 1's free front plate are held at 0; flat
-//   and narrow modes hold every hinge at 0 (the chain stays straight).
+//   mode holds every hinge at 0 (the chain stays straight).
 #pragma once
 
 #include <array>
 #include <string>
 
+#include "morphology/configuration.hpp"  // kMaxModules
+
 namespace comorph::control {
 
 inline constexpr int kActionSize = 5;
-inline constexpr int kMaxModules = 10;
 
-enum class MotionMode : int { flat = 0, stair = 1, narrow = 2 };
-inline constexpr int kMotionModes = 3;
+enum class MotionMode : int { flat = 0, stair = 1 };
 const char* mode_name(MotionMode m);
 MotionMode parse_mode(const std::string& name);  // throws std::invalid_argument
 
@@ -45,10 +45,10 @@ struct MotionParams {
   double wave_frequency = 0.6;   // Hz, f of Eq. 5
   ModeWeights flat{1.0, 0.6, 0.0, 0.0};    // fast straight, moderate turning, straight chain
   ModeWeights stair{0.5, 0.2, 1.0, 1.0};   // slow, little turning, travelling wave
+  // The paper's narrow-passage mode: no scenario drives in it, but
+  // configs/sim/motion.yaml sets its weights, so they are still read.
   ModeWeights narrow{0.4, 1.0, 0.0, 0.0};  // slow straight, strong turning
-  const ModeWeights& weights(MotionMode m) const {
-    return m == MotionMode::stair ? stair : m == MotionMode::narrow ? narrow : flat;
-  }
+  const ModeWeights& weights(MotionMode m) const { return m == MotionMode::stair ? stair : flat; }
 };
 
 // Motor commands for a chain of `modules` modules (entries beyond are zero).

@@ -22,7 +22,7 @@ TEST(MotionModes, Eq4WheelSpeedsPerMode) {
   }
   EXPECT_EQ(c.wheel_left[4], 0.0);  // beyond the chain
   const float mixed[5] = {0.5f, -0.5f, 0.0f, 0.0f, 0.0f};
-  for (MotionMode m : {MotionMode::flat, MotionMode::stair, MotionMode::narrow}) {
+  for (MotionMode m : {MotionMode::flat, MotionMode::stair}) {
     const control::ModeWeights& w = p.weights(m);
     control::compute_command(p, m, mixed, 0.0, 3, r, cap, c);
     EXPECT_NEAR(c.wheel_left[0], (w.w1 * 0.5 * p.v_straight_max + w.w2 * 0.5 * p.v_turn_max) / r, 1e-12);
