@@ -95,8 +95,6 @@ task::EpisodeSpec scene_episode(const SceneDatasetParams& p, std::uint64_t scene
   return draw_spec(rng, scene_seed, p.min_modules, p.max_modules, p.min_obstacles, p.max_obstacles);
 }
 
-const char* frame_source_name(FrameSource s) { return s == FrameSource::run ? "run" : "view"; }
-
 void parse_seed_range(const std::string& text, const std::string& what, std::uint64_t& first,
                       std::uint64_t& last) {
   auto number = [&](const std::string& t) {

@@ -42,7 +42,6 @@ enum class FrameSource : std::uint8_t {
   run = 0,   // recorded along a scripted-pilot run
   view = 1,  // level view from a random pose (render_view_from)
 };
-const char* frame_source_name(FrameSource s);  // "run" | "view"
 
 struct SceneDatasetParams {
   std::uint64_t first_seed = 1;   // scene seeds first_seed..last_seed, inclusive

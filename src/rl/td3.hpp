@@ -42,7 +42,6 @@ class Td3 final : public Learner {
   double bc_weight_now() const;  // w of the behaviour-cloning term at the current update
   const Td3Config& config() const { return config_; }
   ActorCritic& networks() { return nets_; }
-  ActorCritic& target_networks() { return target_; }
   ReplayBuffer& replay() override { return replay_; }
 
  private:
