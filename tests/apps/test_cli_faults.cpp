@@ -190,4 +190,26 @@ TEST(Inputs, MissingDirectoriesDirectoriesAsFilesAndHugeFilesAreRefused) {
   EXPECT_FALSE(fs::exists(dir + "/run"));
 }
 
+// `config validate` checks what the simulator builds, not only the file.
+TEST(ConfigValidate, BuildsTheRobotTheFileDescribesAndNamesTheFault) {
+  const std::string dir = temp_dir("config_validate");
+  std::string log;
+  ASSERT_EQ(run_shell(kExe + " config chain -n 4 > " + dir + "/chain.yaml", log), 0) << log;
+  EXPECT_EQ(run_cli("config validate " + dir + "/chain.yaml --config-dir " + kSim, log), 0) << log;
+  EXPECT_NE(log.find("valid, chain of 4 modules: 1-2-3-4; the simulator builds it: 17 joints, 16 actuators"),
+            std::string::npos)
+      << log;
+  // Module 2's back face docked to module 3's back face: plates fit, but it is no chain.
+  std::string c_a = "C_a:\n";
+  for (int i = 0; i < 10; ++i) {
+    c_a += "  - [";
+    for (int j = 0; j < 10; ++j) c_a += std::string(j ? "," : "") + (std::abs(i - j) == 1 && i < 3 && j < 3 ? "1" : "0");
+    c_a += "]\n";
+  }
+  std::ofstream(dir + "/back_to_back.yaml") << c_a << "C_s:\n  - [1,2,2,1,1]\n  - [2,3,2,2,1]\n";
+  EXPECT_EQ(exit_code(run_cli("config validate " + dir + "/back_to_back.yaml --config-dir " + kSim, log)), 1);
+  EXPECT_NE(log.find("is not a chain link"), std::string::npos) << log;
+  fs::remove_all(dir);
+}
+
 }  // namespace
