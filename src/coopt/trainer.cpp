@@ -942,6 +942,7 @@ Trainer::Trainer(const CooptConfig& config, const std::string& run_dir, TrainerC
 Trainer::~Trainer() = default;
 
 void Trainer::resume() { impl_->load_checkpoint(); }
+void Trainer::checkpoint() { impl_->save_checkpoint(); }
 int Trainer::episodes_done() const { return impl_->episode; }
 int Trainer::evaluations_done() const { return impl_->evaluations; }
 std::int64_t Trainer::env_steps() const { return impl_->steps; }

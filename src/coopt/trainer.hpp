@@ -144,6 +144,8 @@ class Trainer {
   // Trains until every episode is done (returns true) or *stop becomes true
   // (the current episode is finished and checkpointed; returns false).
   bool run(const std::atomic<bool>* stop = nullptr);
+  // Writes a checkpoint now (between episodes).
+  void checkpoint();
 
   int episodes_done() const;
   int evaluations_done() const;
