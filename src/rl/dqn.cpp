@@ -63,7 +63,8 @@ void Dqn::act(const Observation& o, bool explore, Action& action) {
 
 void Dqn::store(const Observation& o, const Action& action, float reward, const Observation& next,
                 bool terminated, bool truncated, int steps) {
-  replay_.add(o, action, reward, next, terminated, static_cast<float>(std::pow(config_.gamma, steps)));
+  const int discount_steps = config_.discount_per == "decision" ? 1 : steps;
+  replay_.add(o, action, reward, next, terminated, static_cast<float>(std::pow(config_.gamma, discount_steps)));
   ++counters_.transitions;
   if (terminated || truncated) ++counters_.episodes;
 }

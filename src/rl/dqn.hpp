@@ -7,7 +7,8 @@
 //   observation's mask, and the target maximises only over the next state's
 //   valid actions (stored with the transition);
 // - Huber or MSE loss, optional gradient-norm clipping, optional Double DQN;
-// - per-transition discount gamma^k (semi-MDP decisions that last k steps).
+// - per-transition discount gamma^k (semi-MDP decisions that last k steps),
+//   or gamma per decision (DqnConfig::discount_per).
 #pragma once
 
 #include <torch/torch.h>

@@ -25,10 +25,14 @@ DqnConfig DqnConfig::from_yaml(const YAML::Node& node, const std::string& source
   f.add("epsilon_decay", &c.epsilon_decay, 0.0, 1e12);
   f.add("loss", &c.loss);
   f.add("double_dqn", &c.double_dqn);
+  f.add("discount_per", &c.discount_per);
   f.apply(node);
   check_shared_learner_fields(f, c);
   if (c.loss != "huber" && c.loss != "mse")
     throw std::invalid_argument(source + ": field \"loss\" must be huber or mse, got \"" + c.loss + "\"");
+  if (c.discount_per != "step" && c.discount_per != "decision")
+    throw std::invalid_argument(source + ": field \"discount_per\" must be step or decision, got \"" +
+                                c.discount_per + "\"");
   return c;
 }
 

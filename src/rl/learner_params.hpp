@@ -65,7 +65,12 @@ void check_shared_learner_fields(const YamlFields& f, const LearnerConfig& c) {
 }
 
 struct DqnConfig {
-  double gamma = 0.99;                  // discount per environment step
+  double gamma = 0.99;                  // discount per environment step (see discount_per)
+  // "step": a transition that lasted k environment steps bootstraps with
+  // gamma^k (semi-MDP). "decision": with gamma once per stored transition,
+  // however long it lasted (the paper's Algorithm 1, line 15); a slow segment
+  // then costs only through its own rewards, not through the discount.
+  std::string discount_per = "step";
   double learning_rate = 2.5e-4;        // Adam step size
   double adam_epsilon = 1e-8;           // Adam's epsilon
   int batch_size = 128;                 // transitions per update

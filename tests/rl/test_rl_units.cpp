@@ -345,6 +345,30 @@ TEST(Dqn, TargetMaximisesOverNextValidActionsAndRespectsTermination) {
   }
 }
 
+TEST(Dqn, DiscountPerDecisionIgnoresTheSegmentLength) {
+  rl::DqnConfig c;
+  c.hidden_sizes = {16};
+  c.gamma = 0.9;
+  c.discount_per = "decision";
+  rl::Dqn dqn({0, 0, 0, 2}, 2, c, 3);
+  rl::Action a;
+  a.discrete = 0;
+  const rl::Observation s = vector_obs({0.1f, 0.2f});
+  const rl::Observation next = vector_obs({0.3f, -0.4f}, {1, 1});
+  dqn.store(s, a, 1.0f, next, false, false, /*steps=*/1);
+  dqn.store(s, a, 1.0f, next, false, false, /*steps=*/300);  // a long segment: still gamma once
+  const rl::ReplayBatch b = dqn.replay().gather(torch::arange(2), torch::kCPU);
+  const torch::Tensor y = dqn.td_target(b);
+  torch::Tensor q_next;
+  {
+    torch::NoGradGuard g;
+    q_next = dqn.target_network()->forward({}, b.next_vector[0].unsqueeze(0))[0];
+  }
+  const float best = q_next.max().item<float>();
+  EXPECT_NEAR(y[0].item<float>(), 1.0f + 0.9f * best, 1e-5);
+  EXPECT_NEAR(y[1].item<float>(), 1.0f + 0.9f * best, 1e-5);
+}
+
 TEST(Dqn, EpsilonScheduleIsLinearThenFlat) {
   rl::DqnConfig c;
   c.hidden_sizes = {8};
@@ -522,6 +546,7 @@ TEST(Config, EveryPresetLoadsAndUnknownFieldsAreRejected) {
     EXPECT_NE(std::string(e.what()).find("my.yaml"), std::string::npos);
   }
   EXPECT_THROW(rl::DqnConfig::from_yaml(YAML::Load("loss: l1"), "x"), std::invalid_argument);
+  EXPECT_THROW(rl::DqnConfig::from_yaml(YAML::Load("discount_per: episode"), "x"), std::invalid_argument);
   EXPECT_THROW(rl::SacConfig::from_yaml(YAML::Load("batch_size: abc"), "x"), std::runtime_error);
   EXPECT_THROW(rl::make_learner("dqn", {0, 0, 0, 3}, {rl::ActionKind::kContinuous, 1}, YAML::Node(),
                                 "x", 1),
