@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli_numbers.hpp"
+#include "morphology/configuration.hpp"
 #include "command_registry.hpp"
 #include "run_steps.hpp"
 
@@ -29,7 +30,7 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
 
   auto* ev = app.add_subcommand("eval", "greedy evaluation of a trained run (writes eval-<scenario>.json)");
   static std::string run, scenario = "default";
-  static int episodes = 0, seed = -1, workers = 0;
+  static int episodes = 0, seed = -1, workers = 0, forced_modules = 0;
   ev->add_option("--run", run, "run directory")->required();
   ev->add_option("--scenario", scenario, "default | obstacles7 | obstacles8 | mixed");
   // The same ranges as the config's eval section (coopt/config.cpp).
@@ -39,7 +40,11 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
       ->check(comorph::cli::whole_in(0, 2000000000));
   ev->add_option("--workers", workers, "threads (default: eval.workers; 0 there = one per core); results do not depend on it")
       ->check(comorph::cli::whole_in(1, 256));
-  ev->callback([] { comorph::cli::eval_run(run, scenario, episodes, seed, workers); });
+  ev->add_option("--modules", forced_modules,
+                 "drive a fixed chain of this many modules with the run's motion model (no configuration model, "
+                 "no shedding): what the motion model can do with each body; writes eval-<scenario>-modules<N>.*")
+      ->check(comorph::cli::whole_in(comorph::kMinModules, comorph::kMaxModules));
+  ev->callback([] { comorph::cli::eval_run(run, scenario, episodes, seed, workers, forced_modules); });
 
   auto* ex = app.add_subcommand("export", "copy a trained run's policies (no replay buffers) and logs, e.g. into results/");
   static std::string export_run, export_out;

@@ -239,7 +239,7 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
 }
 
 report::Metrics eval_run(const std::string& run_dir, const std::string& scenario, int episodes, int seed,
-                         int workers) {
+                         int workers, int forced_modules) {
   const std::string path = (fs::path(run_dir) / "config.yaml").string();
   if (!fs::exists(path)) throw std::runtime_error(run_dir + ": not a training run (no config.yaml)");
   const CooptConfig config = comorph::coopt::load_coopt_config(path);
@@ -252,18 +252,22 @@ report::Metrics eval_run(const std::string& run_dir, const std::string& scenario
   request.seed = seed >= 0 ? seed : config.eval.seed;
   request.workers = workers > 0 ? workers : config.eval.workers;
   if (request.workers == 0) request.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  request.forced_modules = forced_modules;
   const auto logs = comorph::coopt::evaluate(config, run_dir, request);
 
   std::vector<comorph::report::EpisodeRecord> records;
   for (const auto& l : logs) records.push_back(to_record(l));
   const auto m = comorph::report::summarize(records, f_weights(config));
-  const std::string json = (fs::path(run_dir) / ("eval-" + scenario + ".json")).string();
-  const std::string csv = (fs::path(run_dir) / ("eval-" + scenario + "-episodes.csv")).string();
+  const std::string name =
+      "eval-" + scenario + (forced_modules > 0 ? "-modules" + std::to_string(forced_modules) : std::string());
+  const std::string json = (fs::path(run_dir) / (name + ".json")).string();
+  const std::string csv = (fs::path(run_dir) / (name + "-episodes.csv")).string();
   comorph::report::write_metrics_json(json, m);
   comorph::report::write_episodes_csv(csv, records);
 
-  std::printf("%s, scenario %s: %d greedy episodes (seeds %d..%d)\n", run_dir.c_str(), scenario.c_str(),
-              request.episodes, request.seed, request.seed + request.episodes - 1);
+  std::printf("%s, scenario %s: %d greedy episodes (seeds %d..%d)%s\n", run_dir.c_str(), scenario.c_str(),
+              request.episodes, request.seed, request.seed + request.episodes - 1,
+              forced_modules > 0 ? fmt::format(", forced chain of {} modules", forced_modules).c_str() : "");
   std::printf("%-8s %-9s %s\n", "stairs", "success", "configurations (episodes)");
   for (const std::string& key : comorph::report::paper_stair_keys()) {
     std::string seqs;

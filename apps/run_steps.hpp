@@ -28,9 +28,11 @@ void clear_run_dir(const std::string& dir);
 // Greedy evaluation of a trained run on the paper's protocol: writes
 // eval-<scenario>.json and eval-<scenario>-episodes.csv into the run
 // directory and prints the summary. episodes/seed/workers <= 0 (seed < 0):
-// the run config's eval section.
+// the run config's eval section. forced_modules > 0: the run's motion model
+// drives a fixed chain of that many modules (EvalRequest::forced_modules);
+// the files are then eval-<scenario>-modules<N>.json and -episodes.csv.
 report::Metrics eval_run(const std::string& run_dir, const std::string& scenario, int episodes, int seed,
-                         int workers);
+                         int workers, int forced_modules = 0);
 
 // Copies what `eval`, `render` and `report` need of a trained run into `out`
 // (config.yaml, run.yaml, episodes.csv rounded to the report's digits,

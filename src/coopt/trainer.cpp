@@ -1148,8 +1148,18 @@ struct GreedyPlayer {
 
 }  // namespace
 
-std::vector<EpisodeLog> evaluate(const CooptConfig& config, const std::string& run_dir, const EvalRequest& request) {
-  const CheckpointInfo info = open_checkpoint_for_evaluation(config, run_dir);
+std::vector<EpisodeLog> evaluate(const CooptConfig& run_config, const std::string& run_dir,
+                                 const EvalRequest& request) {
+  const CheckpointInfo info = open_checkpoint_for_evaluation(run_config, run_dir);
+  CooptConfig config = run_config;  // the identity (text) stays the run's
+  if (request.forced_modules != 0) {
+    if (request.forced_modules < kMinModules || request.forced_modules > kMaxModules)
+      throw std::invalid_argument("evaluate: forced chain of " + std::to_string(request.forced_modules) +
+                                  " modules, not in [" + std::to_string(kMinModules) + ", " +
+                                  std::to_string(kMaxModules) + "]");
+    config.trainer.mode = "fixed";  // play() then drives make_chain(fixed_modules) and no DQN is loaded
+    config.trainer.fixed_modules = request.forced_modules;
+  }
   std::vector<EpisodeLog> logs(static_cast<std::size_t>(request.episodes));
   std::atomic<int> next{0};
   std::mutex error_mutex;

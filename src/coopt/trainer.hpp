@@ -191,6 +191,9 @@ struct EvalRequest {
   int episodes = 30;                 // stair height of episode i = heights[i % 3]
   int seed = 700000;                 // seed of episode i = seed + i
   int workers = 2;                   // threads (each its own env and network copies)
+  int forced_modules = 0;            // > 0: the run's motion model drives a fixed chain of this many
+                                     // modules (configuration model unused, no shedding): what the
+                                     // motion model can do with each body
 };
 // Loads run_dir/checkpoint; results are ordered by episode and do not depend on `workers`.
 std::vector<EpisodeLog> evaluate(const CooptConfig& config, const std::string& run_dir,

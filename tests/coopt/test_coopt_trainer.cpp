@@ -445,6 +445,15 @@ TEST(Evaluate, GreedyEpisodesCycleHeightsAndDoNotDependOnWorkers) {
   }
   req.scenario = "obstacles8";
   EXPECT_EQ(evaluate(c, dir, req)[0].obstacles, 8);
+  // A forced chain: the motion model drives it, the DQN neither picks nor sheds.
+  ASSERT_EQ(c.trainer.mode, "hierarchical");
+  req.scenario = "default";
+  for (int modules : {3, 7}) {
+    req.forced_modules = modules;
+    for (const EpisodeLog& l : evaluate(c, dir, req)) EXPECT_EQ(l.configurations, std::vector<int>{modules});
+  }
+  req.forced_modules = kMaxModules + 1;
+  EXPECT_THROW(evaluate(c, dir, req), std::invalid_argument);
   fs::remove_all(dir);
 }
 
