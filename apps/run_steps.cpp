@@ -289,7 +289,26 @@ report::Metrics eval_run(const std::string& run_dir, const std::string& scenario
               std::isnan(m.energy_J) ? "-" : fmt::format("{:.0f}", m.energy_J).c_str(), m.F);
   std::string terms;
   for (const auto& [reason, n] : m.terminations) terms += (terms.empty() ? "" : ", ") + reason + " " + std::to_string(n);
-  std::printf("terminations: %s\nwrote %s and %s\n", terms.c_str(), json.c_str(), csv.c_str());
+  std::printf("terminations: %s\n", terms.c_str());
+  // What the first decision is paid, per stair height: the quantities its
+  // choice trades (R2 = summed R1 + the climb reward - sigma3 x stair energy).
+  std::printf("first segment (to the first declared switch), means per stair height:\n");
+  for (const std::string& key : comorph::report::paper_stair_keys()) {
+    double r2 = 0, r1 = 0, steps = 0, stairs_J = 0;
+    int n = 0;
+    for (const auto& l : logs)
+      if (comorph::report::stair_key(l.stair_height_m) == key) {
+        r2 += l.first_segment_R2;
+        r1 += l.first_segment_R1;
+        steps += l.first_segment_steps;
+        stairs_J += l.stairs_energy_J;
+        ++n;
+      }
+    if (n > 0)
+      std::printf("  %s m: R2 %.1f, summed R1 %.1f, %.0f control steps; stair energy E_c %.0f J (%d episodes)\n",
+                  key.c_str(), r2 / n, r1 / n, steps / n, stairs_J / n, n);
+  }
+  std::printf("wrote %s and %s\n", json.c_str(), csv.c_str());
   return m;
 }
 

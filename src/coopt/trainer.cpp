@@ -245,6 +245,13 @@ control::MotionMode mode_of(int scene) {
   return scene == sim::kLabelStairs ? control::MotionMode::stair : control::MotionMode::flat;
 }
 
+void record_first_segment(const CooptConfig& c, const task::MultiTaskEnv& env, const Segment& segment,
+                          EpisodeLog& log) {
+  log.first_segment_R2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
+  log.first_segment_R1 = segment.sum_r1();
+  log.first_segment_steps = segment.steps();
+}
+
 // One episode; learn == hooks present. The env is reset here. `observe` (may
 // be null) sees the env after the reset that starts control and after every step.
 EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, SceneSource& scene,
@@ -332,7 +339,7 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
     const perception::SwitchDecision d = scene.step(env);
     lap(kClassifier);
     if (!d.switched) continue;
-    ++log.switches;
+    if (log.switches++ == 0) record_first_segment(c, env, segment, log);
     if (!hierarchical) continue;
     // 3. A declared switch ends the segment: one semi-MDP transition, then a
     //    new decision among [2, C_n].
@@ -354,6 +361,7 @@ EpisodeLog play(const CooptConfig& c, Agent& agent, task::MultiTaskEnv& env, Sce
     lap(kActing);
   }
   // 4. The last segment.
+  if (log.switches == 0) record_first_segment(c, env, segment, log);
   if (hierarchical) {
     const double r2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
     return_r2 += r2;

@@ -50,6 +50,12 @@ struct EpisodeLog : task::EpisodeRecord {
   int steps = 0;                    // control steps
   int switches = 0;                 // scene switches declared by the detector
   double stairs_energy_J = 0;       // E_c: J drawn while on the stairs (the R2 cost)
+  // The first configuration's segment (start to the first declared switch, or
+  // to the end), also in fixed mode: what the first decision is paid (R2,
+  // Eq. 7), how long it lasted and its summed R1. Diagnostics of the choice.
+  double first_segment_R2 = 0;
+  double first_segment_R1 = 0;
+  int first_segment_steps = 0;
   bool warmup = false;              // random-action warm-up episode
 };
 

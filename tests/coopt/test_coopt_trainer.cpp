@@ -439,6 +439,14 @@ TEST(Evaluate, GreedyEpisodesCycleHeightsAndDoNotDependOnWorkers) {
   ASSERT_EQ(one.size(), 5u);
   ASSERT_EQ(two.size(), 5u);
   for (int i = 0; i < 5; ++i) {
+    // The first decision's segment: part of the episode, the whole of it when no switch came.
+    EXPECT_GT(one[i].first_segment_steps, 0);
+    EXPECT_LE(one[i].first_segment_steps, one[i].steps);
+    if (one[i].switches == 0) {
+      EXPECT_EQ(one[i].first_segment_steps, one[i].steps);
+      EXPECT_DOUBLE_EQ(one[i].first_segment_R2, one[i].return_R2);
+      EXPECT_NEAR(one[i].first_segment_R1, one[i].return_R1, 1e-6);
+    }
     EXPECT_EQ(line_of(one[i]), line_of(two[i]));
     EXPECT_EQ(one[i].seed, 123u + i);
     EXPECT_NEAR(one[i].stair_height_m, (i % 3 == 0 ? 0.04 : i % 3 == 1 ? 0.06 : 0.08), 1e-9);
@@ -450,7 +458,10 @@ TEST(Evaluate, GreedyEpisodesCycleHeightsAndDoNotDependOnWorkers) {
   req.scenario = "default";
   for (int modules : {3, 7}) {
     req.forced_modules = modules;
-    for (const EpisodeLog& l : evaluate(c, dir, req)) EXPECT_EQ(l.configurations, std::vector<int>{modules});
+    for (const EpisodeLog& l : evaluate(c, dir, req)) {
+      EXPECT_EQ(l.configurations, std::vector<int>{modules});
+      EXPECT_GT(l.first_segment_steps, 0);  // also logged without a configuration model
+    }
   }
   req.forced_modules = kMaxModules + 1;
   EXPECT_THROW(evaluate(c, dir, req), std::invalid_argument);
