@@ -94,7 +94,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
               "learner_thread", "torch_threads", "motion_image", "config_vector", "scene_source",
               "motion_clearance", "normalize_state", "decision_camera", "warmup_policy", "warmup_noise",
               "scripted_interval", "pilot_random_configs", "pilot_gait_per_modules", "pilot_labels",
-              "greedy_motion_interval", "config_learns_from",
+              "greedy_motion_interval", "config_learns_from", "config_target",
               "config_refit_episodes",
               "classifier_dir", "scenario", "stair_height", "eval_interval", "eval_episodes", "eval_seed",
               "checkpoint_interval", "progress_interval", "env_dir"});
@@ -103,7 +103,8 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   YamlFields f(source);
   YAML::Node numbers(YAML::NodeType::Map);
   const std::vector<std::string> strings{"mode",     "motion_algo", "scene_source", "classifier_dir",
-                                         "scenario", "env_dir",     "warmup_policy", "config_learns_from"};
+                                         "scenario", "env_dir",     "warmup_policy", "config_learns_from",
+                                         "config_target"};
   for (const auto& kv : n) {
     const std::string k = kv.first.as<std::string>();
     bool is_string = false;
@@ -143,6 +144,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
                                                                : s == "scenario" ? p.scenario
                                                                : s == "warmup_policy" ? p.warmup_policy
                                                                : s == "config_learns_from" ? p.config_learns_from
+                                                               : s == "config_target" ? p.config_target
                                                                                  : p.env_dir);
   one_of(source, pre + ".mode", p.mode, {"hierarchical", "fixed"});
   one_of(source, pre + ".motion_algo", p.motion_algo, {"td3", "sac"});
@@ -150,6 +152,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   one_of(source, pre + ".scenario", p.scenario, {"default", "obstacles7", "obstacles8", "mixed"});
   one_of(source, pre + ".warmup_policy", p.warmup_policy, {"random", "scripted"});
   one_of(source, pre + ".config_learns_from", p.config_learns_from, {"all", "model", "greedy"});
+  one_of(source, pre + ".config_target", p.config_target, {"bootstrap", "return"});
   if (p.config_learns_from == "greedy" && p.greedy_motion_interval < 1)
     fail(source, pre + ".config_learns_from", "greedy needs trainer.greedy_motion_interval >= 1");
   // A run without a single episode would end at once with no checkpoint to resume or evaluate.

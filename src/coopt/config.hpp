@@ -68,6 +68,14 @@ struct TrainerParams {
   // cannot drive yet, and the exploring model with chains the greedy one
   // cannot (3 modules at 0.06 m: 40 of 43 exploring, 0 of 10 greedy).
   std::string config_learns_from = "all";
+  // The DQN's target for a decision: bootstrap (Eq. 3: R2 + gamma max Q(s'))
+  // | return (the R2 of this and every later segment of the episode, each
+  // later one discounted once more by dqn.gamma, stored as terminal). The
+  // return needs no estimate of the state after the stairs, which the decision
+  // image cannot tell apart: a longer chain's head is farther along when the
+  // stairs segment ends (one module length, 16 of R1, per module) and the rest
+  // of the course is shorter by as much, which bootstrapping does not see.
+  std::string config_target = "bootstrap";
   // After the training episodes, this many more in which the motion model is
   // frozen and greedy and a fresh DQN (the dqn: section, its own epsilon
   // schedule) learns from every decision. Its values then describe the final

@@ -66,4 +66,12 @@ double Segment::r2(const task::R2Params& params, double stair_height_m, double s
                          stair_energy_J - energy_at_start_J_);
 }
 
+void to_decision_returns(std::vector<float>& r2, double gamma) {
+  double later = 0;
+  for (std::size_t i = r2.size(); i-- > 0;) {
+    later = r2[i] + gamma * later;
+    r2[i] = static_cast<float>(later);
+  }
+}
+
 }  // namespace comorph::coopt

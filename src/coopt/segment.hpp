@@ -57,4 +57,9 @@ class Segment {
   double energy_at_start_J_ = 0;
 };
 
+// trainer.config_target: return. In place: each decision's R2 becomes the
+// R2 of its segment plus, discounted by gamma once per decision, the return
+// of the decisions after it in the episode.
+void to_decision_returns(std::vector<float>& r2, double gamma);
+
 }  // namespace comorph::coopt

@@ -645,6 +645,10 @@ struct Trainer::Impl {
   // learner consumes the other one.
   std::vector<Transition> pending[2];
   int filling = 0, filled = 0;
+  // trainer.config_target: return: the episode's decisions, stored at its end.
+  std::vector<Transition> episode_decisions;
+  std::vector<int> episode_decision_steps;
+  std::vector<float> episode_decision_returns;
   std::unique_ptr<LearnerWorker> worker;
 
   int episode = 0, evaluations = 0;
@@ -729,6 +733,23 @@ struct Trainer::Impl {
     laps.lap(kHandover);
   }
 
+  // trainer.config_target: return. Each decision of the ended episode is
+  // stored with the R2 of its own and every later segment (each later one
+  // discounted once more by dqn.gamma) as a terminal transition.
+  void learn_episode_returns() {
+    episode_decision_returns.clear();
+    for (const Transition& d : episode_decisions) episode_decision_returns.push_back(d.reward);
+    to_decision_returns(episode_decision_returns, config.dqn.gamma);
+    for (std::size_t i = 0; i < episode_decisions.size(); ++i) {
+      const Transition& d = episode_decisions[i];
+      agent.config->store(d.obs, d.action, episode_decision_returns[i], d.next, /*terminated=*/true, false,
+                          episode_decision_steps[i]);
+      for (int u = agent.config->updates_due(); u > 0; --u) agent.config->update();
+    }
+    episode_decisions.clear();
+    episode_decision_steps.clear();
+  }
+
   EpisodeLog train_episode() {
     const TrainerParams& t = config.trainer;
     const bool warmup = episode < t.warmup_episodes;
@@ -773,8 +794,18 @@ struct Trainer::Impl {
     hooks.config = [this, config_learns](const rl::Observation& o, const rl::Action& a, float r2,
                                          const rl::Observation& n, bool term, bool trunc, int k) {
       if (!config_learns) return;
-      agent.config->store(o, a, r2, n, term, trunc, k);
-      for (int u = agent.config->updates_due(); u > 0; --u) agent.config->update();
+      if (config.trainer.config_target == "return") {
+        Transition& d = episode_decisions.emplace_back();  // 2 or 3 an episode
+        d.obs = o;
+        d.next = n;
+        d.action = a;
+        d.reward = r2;
+        episode_decision_steps.push_back(k);
+        if (term || trunc) learn_episode_returns();
+      } else {
+        agent.config->store(o, a, r2, n, term, trunc, k);
+        for (int u = agent.config->updates_due(); u > 0; --u) agent.config->update();
+      }
       if (callbacks.on_decision) {
         DecisionLog d;
         d.episode = episode;

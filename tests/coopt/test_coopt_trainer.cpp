@@ -166,6 +166,26 @@ TEST(Trainer, ScriptedWarmupDrivesTowardsTheGoal) {
   fs::remove_all(b);
 }
 
+// trainer.config_target: return stores each episode's decisions at its end;
+// the run completes, reports every decision and leaves an evaluable policy.
+// An unknown target is refused with its key.
+TEST(Trainer, ConfigModelLearnsFromEpisodeReturns) {
+  const std::string dir = temp_dir("dqn_return");
+  const RunResult r = run_ci({"trainer.config_target=return"}, dir);
+  ASSERT_EQ(r.logs.size(), 6u);
+  EXPECT_FALSE(r.decisions.empty());
+  EXPECT_TRUE(r.decisions.back().terminated || r.decisions.back().truncated);
+  const CooptConfig c = load_coopt_config(kCi, {"trainer.config_target=return"});
+  EXPECT_EQ(evaluate(c, dir, {"default", 3, 4242, 1}).size(), 3u);
+  fs::remove_all(dir);
+  try {
+    load_coopt_config(kCi, {"trainer.config_target=td"});
+    FAIL() << "an unknown trainer.config_target was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("trainer.config_target"), std::string::npos) << e.what();
+  }
+}
+
 // trainer.config_learns_from: the DQN stores (and reports) the decisions of
 // every episode (all), of those the motion model drove (model: not the 2
 // warm-up episodes, nor every 2nd), or of those it drove greedily (greedy,

@@ -35,6 +35,17 @@ TEST(CandidateMask, ActionIndexIsTheChainLengthMinusTwo) {
   }
 }
 
+TEST(Segment, DecisionReturnsSumTheLaterSegmentsDiscountedOncePerDecision) {
+  std::vector<float> r2{300.0f, 500.0f, -10.0f};
+  to_decision_returns(r2, 0.5);
+  EXPECT_FLOAT_EQ(r2[2], -10.0f);
+  EXPECT_FLOAT_EQ(r2[1], 500.0f + 0.5f * -10.0f);
+  EXPECT_FLOAT_EQ(r2[0], 300.0f + 0.5f * 495.0f);
+  std::vector<float> none;
+  to_decision_returns(none, 0.99);
+  EXPECT_TRUE(none.empty());
+}
+
 TEST(Segment, StairSegmentAccumulatesR1AndPaysClimbMinusStairEnergy) {
   task::R2Params p;  // sigma1 1, s_base 0.04, r_s 60, sigma3 0.003
   Segment s;
