@@ -646,8 +646,8 @@ struct Trainer::Impl {
   std::vector<Transition> pending[2];
   int filling = 0, filled = 0;
   // trainer.config_target: return: the episode's decisions, stored at its end.
+  // Their observations and actions, and their R2 (turned into returns).
   std::vector<Transition> episode_decisions;
-  std::vector<int> episode_decision_steps;
   std::vector<float> episode_decision_returns;
   std::unique_ptr<LearnerWorker> worker;
 
@@ -737,17 +737,15 @@ struct Trainer::Impl {
   // stored with the R2 of its own and every later segment (each later one
   // discounted once more by dqn.gamma) as a terminal transition.
   void learn_episode_returns() {
-    episode_decision_returns.clear();
-    for (const Transition& d : episode_decisions) episode_decision_returns.push_back(d.reward);
     to_decision_returns(episode_decision_returns, config.dqn.gamma);
     for (std::size_t i = 0; i < episode_decisions.size(); ++i) {
       const Transition& d = episode_decisions[i];
-      agent.config->store(d.obs, d.action, episode_decision_returns[i], d.next, /*terminated=*/true, false,
-                          episode_decision_steps[i]);
+      // Terminal: no bootstrap, so the segment's length (the discount's k) plays no part.
+      agent.config->store(d.obs, d.action, episode_decision_returns[i], d.next, /*terminated=*/true, false);
       for (int u = agent.config->updates_due(); u > 0; --u) agent.config->update();
     }
     episode_decisions.clear();
-    episode_decision_steps.clear();
+    episode_decision_returns.clear();
   }
 
   EpisodeLog train_episode() {
@@ -799,8 +797,7 @@ struct Trainer::Impl {
         d.obs = o;
         d.next = n;
         d.action = a;
-        d.reward = r2;
-        episode_decision_steps.push_back(k);
+        episode_decision_returns.push_back(r2);
         if (term || trunc) learn_episode_returns();
       } else {
         agent.config->store(o, a, r2, n, term, trunc, k);
