@@ -5,6 +5,7 @@
 
 #include "sim/params.hpp"
 #include "common/yaml_fields.hpp"
+#include "rl/registry.hpp"
 
 namespace comorph::coopt {
 namespace {
@@ -147,7 +148,13 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
                                                                : s == "config_target" ? p.config_target
                                                                                  : p.env_dir);
   one_of(source, pre + ".mode", p.mode, {"hierarchical", "fixed"});
-  one_of(source, pre + ".motion_algo", p.motion_algo, {"td3", "sac"});
+  if (!rl::has_learner(p.motion_algo) || rl::learner_entry(p.motion_algo).actions != rl::ActionKind::kContinuous) {
+    std::string names;
+    for (const std::string& n : rl::learner_names())
+      if (rl::learner_entry(n).actions == rl::ActionKind::kContinuous) names += (names.empty() ? "" : " | ") + n;
+    fail(source, pre + ".motion_algo", "'" + quote_value(p.motion_algo) + "' is not one of " + names +
+                                           " (the registered learners of continuous actions)");
+  }
   one_of(source, pre + ".scene_source", p.scene_source, {"ground_truth", "classifier"});
   one_of(source, pre + ".scenario", p.scenario, {"default", "obstacles7", "obstacles8", "mixed"});
   one_of(source, pre + ".warmup_policy", p.warmup_policy, {"random", "scripted"});
@@ -239,7 +246,8 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
       throw std::runtime_error(src + ": no '" + name + ":' section: " + needed_by + " needs the " + what +
                                "'s hyperparameters there (configs/quick.yaml has them)");
   };
-  require_section(c.trainer.motion_algo, "trainer.motion_algo " + c.trainer.motion_algo, "motion model");
+  if (c.trainer.motion_algo == "td3" || c.trainer.motion_algo == "sac")  // the typed sections; others: their defaults
+    require_section(c.trainer.motion_algo, "trainer.motion_algo " + c.trainer.motion_algo, "motion model");
   if (c.trainer.mode == "hierarchical") require_section("dqn", "trainer.mode hierarchical", "configuration model");
   const auto given = [&](const char* name) { return root[name] && !root[name].IsNull(); };
   c.td3 = rl::Td3Config::from_yaml(root["td3"], src + ": td3");

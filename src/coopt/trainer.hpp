@@ -16,9 +16,9 @@
 //  4. at the episode end the last segment is stored (terminated/truncated).
 //
 // Both cores: the motion learner (full replay, optimizers) lives on a learner
-// thread; the acting thread runs the simulation with a copy of the actor (a
-// second learner object with a one-slot replay that keeps the exploration
-// counters). Every trainer.sync_interval control steps and at every episode
+// thread; the acting thread runs the simulation with the motion model's
+// rl::Policy (a copy of the acting networks, the exploration schedule and its
+// own RNG). Every trainer.sync_interval control steps and at every episode
 // end the acting thread hands over its transitions, waits for the learner's
 // previous batch of updates and copies the new weights. The schedule is a
 // function of the step count only, so the threaded and the inline mode give
@@ -125,7 +125,7 @@ struct TrainerTiming {
   double env_step_s = 0;        // MultiTaskEnv::step
   double env_reset_s = 0;       // resets (MJCF built for the chain) and reconfigurations
   double acting_s = 0;          // the motion model's act(), the scripted pilot, building observations
-  double handover_s = 0;        // transitions into the hand-over buffer, the acting copy's store, weight copies
+  double handover_s = 0;        // transitions into the hand-over buffer, the policy's count, weight copies
   double waiting_s = 0;         // waiting for the learner's previous job
   double motion_updates_s = 0;  // store + updates run inline (learner_thread: false)
   double dqn_s = 0;             // the configuration model: observation, act, store, updates
@@ -150,8 +150,6 @@ class Trainer {
   // Trains until every episode is done (returns true) or *stop becomes true
   // (the current episode is finished and checkpointed; returns false).
   bool run(const std::atomic<bool>* stop = nullptr);
-  // Writes a checkpoint now (between episodes).
-  void checkpoint();
 
   int episodes_done() const;
   int evaluations_done() const;

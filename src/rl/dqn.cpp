@@ -5,73 +5,71 @@
 
 namespace comorph::rl {
 
-Dqn::Dqn(const ObservationSpec& observation, int num_actions, const DqnConfig& config,
-         std::uint64_t seed)
-    : spec_(observation), num_actions_(num_actions), config_(config), device_(config.device),
-      replay_(observation, {ActionKind::kDiscrete, num_actions}, config.buffer_size,
-              image_storage_from_string(config.image_storage)),
-      rng_(seed) {
-  if (num_actions < 1) throw std::invalid_argument("Dqn: need at least one action");
-  torch::manual_seed(seed);  // network initialisation
-  q_ = QNetwork(spec_, num_actions, config.hidden_sizes, config.image_features, config.image_fc_size);
-  q_target_ = QNetwork(spec_, num_actions, config.hidden_sizes, config.image_features,
-                       config.image_fc_size);
-  q_->to(device_);
-  q_target_->to(device_);
-  copy_parameters(*q_target_, *q_);
-  optimizer_ = std::make_unique<torch::optim::Adam>(
-      q_->parameters(), torch::optim::AdamOptions(config.learning_rate).eps(config.adam_epsilon));
+namespace {
+
+QNetwork make_network(const ObservationSpec& spec, int num_actions, const DqnConfig& c) {
+  QNetwork q(spec, num_actions, c.hidden_sizes, c.image_features, c.image_fc_size);
+  q->to(torch::Device(c.device));
+  return q;
 }
 
-double Dqn::epsilon() const {
-  return LinearSchedule{config_.epsilon_start, config_.epsilon_end, config_.epsilon_decay}.at(
-      static_cast<double>(counters_.transitions));
+double epsilon_at(const DqnConfig& c, const LearnerCounters& n) {
+  return LinearSchedule{c.epsilon_start, c.epsilon_end, c.epsilon_decay}.at(static_cast<double>(n.transitions));
 }
 
-std::vector<float> Dqn::q_values(const Observation& o) {
+std::vector<float> q_values_of(QNetwork& q, const ObservationSpec& spec, int num_actions, const torch::Device& device,
+                               const Observation& o) {
   torch::InferenceMode guard;
-  torch::Tensor q = q_->forward(image_batch(o, spec_, device_), vector_batch(o, spec_, device_))
-                        .to(torch::kCPU);
-  return std::vector<float>(q.data_ptr<float>(), q.data_ptr<float>() + num_actions_);
+  torch::Tensor v = q->forward(image_batch(o, spec, device), vector_batch(o, spec, device)).to(torch::kCPU);
+  return std::vector<float>(v.data_ptr<float>(), v.data_ptr<float>() + num_actions);
 }
 
-void Dqn::act(const Observation& o, bool explore, Action& action) {
+// The acting rule of the learner and of its Policy: epsilon-greedy among the
+// observation's valid actions (the random choice uniform among them).
+void act_with(QNetwork& q, const ObservationSpec& spec, int num_actions, const DqnConfig& c,
+              const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng, const Observation& o,
+              bool explore, Action& action) {
   const auto& mask = o.valid_actions;
-  if (!mask.empty() && static_cast<int>(mask.size()) != num_actions_)
+  if (!mask.empty() && static_cast<int>(mask.size()) != num_actions)
     throw std::invalid_argument("Dqn::act: valid_actions has " + std::to_string(mask.size()) +
-                                " entries, expected " + std::to_string(num_actions_));
+                                " entries, expected " + std::to_string(num_actions));
   auto valid = [&](int a) { return mask.empty() || mask[a] != 0; };
   int valid_count = 0;
-  for (int a = 0; a < num_actions_; ++a) valid_count += valid(a);
+  for (int a = 0; a < num_actions; ++a) valid_count += valid(a);
   if (valid_count == 0) throw std::invalid_argument("Dqn::act: no valid action in the mask");
 
-  if (explore && std::uniform_real_distribution<double>(0.0, 1.0)(rng_) < epsilon()) {
-    // Uniform among the valid actions.
-    int k = std::uniform_int_distribution<int>(0, valid_count - 1)(rng_);
-    for (int a = 0; a < num_actions_; ++a)
+  if (explore && std::uniform_real_distribution<double>(0.0, 1.0)(rng) < epsilon_at(c, n)) {
+    int k = std::uniform_int_distribution<int>(0, valid_count - 1)(rng);
+    for (int a = 0; a < num_actions; ++a)
       if (valid(a) && k-- == 0) {
         action.discrete = a;
         return;
       }
   }
-  const std::vector<float> q = q_values(o);
+  const std::vector<float> values = q_values_of(q, spec, num_actions, device, o);
   int best = -1;
-  for (int a = 0; a < num_actions_; ++a)
-    if (valid(a) && (best < 0 || q[a] > q[best])) best = a;
+  for (int a = 0; a < num_actions; ++a)
+    if (valid(a) && (best < 0 || values[a] > values[best])) best = a;
   action.discrete = best;
 }
 
-void Dqn::store(const Observation& o, const Action& action, float reward, const Observation& next,
-                bool terminated, bool truncated, int steps) {
-  const int discount_steps = config_.discount_per == "decision" ? 1 : steps;
-  replay_.add(o, action, reward, next, terminated, static_cast<float>(std::pow(config_.gamma, discount_steps)));
-  ++counters_.transitions;
-  if (terminated || truncated) ++counters_.episodes;
+}  // namespace
+
+Dqn::Dqn(const ObservationSpec& observation, int num_actions, const DqnConfig& config, std::uint64_t seed)
+    : OffPolicyLearner("dqn", "q", observation, {ActionKind::kDiscrete, num_actions}, config, seed),
+      num_actions_(num_actions), config_(config) {
+  if (num_actions < 1) throw std::invalid_argument("Dqn: need at least one action");
+  build_networks(seed, q_, q_target_, [&] { return make_network(spec_, num_actions, config); });
+  optimizer_ = std::make_unique<torch::optim::Adam>(
+      q_->parameters(), torch::optim::AdamOptions(config.learning_rate).eps(config.adam_epsilon));
 }
 
-int Dqn::updates_due() const {
-  if (counters_.transitions < config_.learning_starts) return 0;
-  return counters_.transitions % config_.train_frequency == 0 ? config_.gradient_steps : 0;
+double Dqn::epsilon() const { return epsilon_at(config_, counters_); }
+
+std::vector<float> Dqn::q_values(const Observation& o) { return q_values_of(q_, spec_, num_actions_, device_, o); }
+
+void Dqn::act(const Observation& o, bool explore, Action& action) {
+  act_with(q_, spec_, num_actions_, config_, device_, counters_, rng_, o, explore, action);
 }
 
 torch::Tensor Dqn::td_target(const ReplayBatch& b) {
@@ -99,10 +97,7 @@ void Dqn::update() {
   const torch::Tensor q = q_->forward(b.image, b.vector).gather(1, b.action.unsqueeze(1)).squeeze(1);
   const torch::Tensor loss = config_.loss == "huber" ? torch::smooth_l1_loss(q, target)
                                                      : torch::mse_loss(q, target);
-  optimizer_->zero_grad();
-  loss.backward();
-  if (config_.max_grad_norm > 0) torch::nn::utils::clip_grad_norm_(q_->parameters(), config_.max_grad_norm);
-  optimizer_->step();
+  gradient_step(*optimizer_, loss, config_.max_grad_norm);
   last_loss_ = loss.item<double>();
   ++counters_.updates;
   if (counters_.updates % config_.target_update_interval == 0) {
@@ -111,38 +106,15 @@ void Dqn::update() {
   }
 }
 
-void Dqn::save(const std::string& path) const { save_to(path, true); }
-void Dqn::save_without_replay(const std::string& path) const { save_to(path, false); }
-
-void Dqn::save_to(const std::string& path, bool with_replay) const {
-  torch::serialize::OutputArchive a, nets, target, opt;
-  write_common(a, counters_, rng_, "dqn");
-  q_->save(nets);
-  q_target_->save(target);
-  optimizer_->save(opt);
-  a.write("q", nets);
-  a.write("q_target", target);
-  a.write("optimizer", opt);
-  write_replay(a, replay_, with_replay);
-  save_archive(a, path);
+Dqn::CheckpointParts Dqn::checkpoint_parts() const {
+  return {{{"q", q_.ptr().get()}, {"q_target", q_target_.ptr().get()}}, {{"optimizer", optimizer_.get()}}};
 }
 
-void Dqn::save_policy(const std::string& path) const {
-  save_policy_file(path, *q_, "q", counters_, rng_, "dqn");
-}
-
-void Dqn::load(const std::string& path) {
-  torch::serialize::InputArchive a, nets, target, opt;
-  a.load_from(path, device_);
-  read_common(a, counters_, rng_, "dqn");
-  if (read_policy_only(a, "q", *q_)) return;
-  a.read("q", nets);
-  a.read("q_target", target);
-  a.read("optimizer", opt);
-  q_->load(nets);
-  q_target_->load(target);
-  optimizer_->load(opt);
-  read_replay(a, replay_);
+std::unique_ptr<Policy> Dqn::policy(const ObservationSpec& observation, int num_actions, const DqnConfig& config,
+                                    std::uint64_t seed) {
+  torch::manual_seed(seed);  // initialised as a learner of this seed; the weights are its learner's after a sync
+  return std::make_unique<NetworkPolicy<QNetwork, DqnConfig>>(
+      "dqn", "q", observation, num_actions, config, seed, make_network(observation, num_actions, config), &act_with);
 }
 
 }  // namespace comorph::rl

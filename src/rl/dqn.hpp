@@ -9,6 +9,7 @@
 // - Huber or MSE loss, optional gradient-norm clipping, optional Double DQN;
 // - per-transition discount gamma^k (semi-MDP decisions that last k steps),
 //   or gamma per decision (DqnConfig::discount_per).
+// Hyperparameters: DqnConfig (rl/learner_params.hpp).
 #pragma once
 
 #include <torch/torch.h>
@@ -18,29 +19,22 @@
 #include <string>
 #include <vector>
 
-#include "rl/learner.hpp"
 #include "rl/networks.hpp"
-#include "rl/replay_buffer.hpp"
+#include "rl/off_policy.hpp"
+#include "rl/policy.hpp"
 
 namespace comorph::rl {
 
-class Dqn final : public Learner {
+class Dqn final : public OffPolicyLearner {
  public:
-  Dqn(const ObservationSpec& observation, int num_actions, const DqnConfig& config,
-      std::uint64_t seed);
+  Dqn(const ObservationSpec& observation, int num_actions, const DqnConfig& config, std::uint64_t seed);
+  // The acting side alone (rl/policy.hpp): the Q network and the
+  // epsilon-greedy choice, on its own RNG seeded `seed`.
+  static std::unique_ptr<Policy> policy(const ObservationSpec& observation, int num_actions, const DqnConfig& config,
+                                        std::uint64_t seed);
 
   void act(const Observation& observation, bool explore, Action& action) override;
-  void store(const Observation& observation, const Action& action, float reward,
-             const Observation& next_observation, bool terminated, bool truncated,
-             int steps = 1) override;
-  int updates_due() const override;
   void update() override;
-  void save(const std::string& path) const override;
-  void save_without_replay(const std::string& path) const override;
-  void load(const std::string& path) override;
-  void save_policy(const std::string& path) const override;
-  const LearnerCounters& counters() const override { return counters_; }
-  double last_loss() const override { return last_loss_; }
 
   double epsilon() const;
   // TD targets r + bootstrap * max over the next state's valid actions of
@@ -49,22 +43,19 @@ class Dqn final : public Learner {
   // Q values of one observation (greedy diagnostics, tests).
   std::vector<float> q_values(const Observation& observation);
   const DqnConfig& config() const { return config_; }
-  ReplayBuffer& replay() override { return replay_; }
   QNetwork& q_network() { return q_; }
   QNetwork& target_network() { return q_target_; }
 
+ protected:
+  torch::nn::Module& acting_module() const override { return *q_.ptr(); }
+  int discount_steps(int steps) const override { return config_.discount_per == "decision" ? 1 : steps; }
+  CheckpointParts checkpoint_parts() const override;
+
  private:
-  void save_to(const std::string& path, bool with_replay) const;
-  ObservationSpec spec_;
   int num_actions_;
   DqnConfig config_;
-  torch::Device device_;
   QNetwork q_{nullptr}, q_target_{nullptr};
   std::unique_ptr<torch::optim::Adam> optimizer_;
-  ReplayBuffer replay_;
-  std::mt19937_64 rng_;
-  LearnerCounters counters_;
-  double last_loss_ = 0;
 };
 
 }  // namespace comorph::rl

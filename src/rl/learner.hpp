@@ -72,6 +72,9 @@ class Learner {
   virtual ReplayBuffer& replay() = 0;
   virtual void save_without_replay(const std::string& path) const = 0;
   virtual const LearnerCounters& counters() const = 0;
+  // The networks act() uses (what save_policy writes): a Policy
+  // (rl/policy.hpp) copies them in Policy::sync_from.
+  virtual const torch::nn::Module& acting_networks() const = 0;
   // Loss of the latest update() (critic / Q loss), for logs.
   virtual double last_loss() const = 0;
 };

@@ -9,9 +9,7 @@
 
 #include "rl/classic/cartpole.hpp"
 #include "rl/classic/pendulum.hpp"
-#include "rl/dqn.hpp"
-#include "rl/sac.hpp"
-#include "rl/td3.hpp"
+#include "rl/registry.hpp"
 
 namespace comorph::rl {
 
@@ -24,18 +22,13 @@ std::unique_ptr<Env> make_classic_env(const std::string& name) {
 std::unique_ptr<Learner> make_learner(const std::string& algorithm, const ObservationSpec& observation,
                                       const ActionSpec& action, const YAML::Node& config,
                                       const std::string& source, std::uint64_t seed) {
-  const bool discrete = action.kind == ActionKind::kDiscrete;
-  if (algorithm == "dqn") {
-    if (!discrete) throw std::invalid_argument("dqn needs discrete actions");
-    return std::make_unique<Dqn>(observation, action.size, DqnConfig::from_yaml(config, source), seed);
-  }
-  if (algorithm == "td3" || algorithm == "sac") {
-    if (discrete) throw std::invalid_argument(algorithm + " needs continuous actions");
-    if (algorithm == "td3")
-      return std::make_unique<Td3>(observation, action.size, Td3Config::from_yaml(config, source), seed);
-    return std::make_unique<Sac>(observation, action.size, SacConfig::from_yaml(config, source), seed);
-  }
-  throw std::invalid_argument("unknown algorithm \"" + algorithm + "\" (td3, sac or dqn)");
+  const LearnerEntry& entry = learner_entry(algorithm);
+  LearnerArgs args;
+  args.observation = observation;
+  args.action = action;
+  args.seed = seed;
+  args.config = entry.read_config(config, source);
+  return make_learner(algorithm, args);
 }
 
 std::string classic_config_path(const std::string& env, const std::string& algorithm) {

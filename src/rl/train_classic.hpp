@@ -16,8 +16,9 @@ namespace comorph::rl {
 // "pendulum" | "cartpole"; throws naming the value otherwise.
 std::unique_ptr<Env> make_classic_env(const std::string& name);
 
-// "td3" | "sac" | "dqn" for an environment with these specs; hyperparameters
-// from `config` (a YAML mapping; missing fields keep the struct defaults).
+// A registered learner (rl/registry.hpp: "td3", "sac", "dqn", ...) for an
+// environment with these specs; hyperparameters from `config` (a YAML
+// mapping; missing fields keep the struct defaults).
 std::unique_ptr<Learner> make_learner(const std::string& algorithm, const ObservationSpec& observation,
                                       const ActionSpec& action, const YAML::Node& config,
                                       const std::string& config_source, std::uint64_t seed);

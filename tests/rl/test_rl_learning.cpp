@@ -1,4 +1,5 @@
-// Learning, determinism and checkpoint tests of DQN, TD3 and SAC.
+// Learning tests of DQN, TD3 and SAC; determinism, checkpoint and policy tests
+// of every registered learner (rl/registry.hpp).
 //
 // Learning tests use short runs whose thresholds leave a margin above what
 // the untrained (or broken) learner gets; each test also checks that the
@@ -11,6 +12,8 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <functional>
+#include <map>
 #include <numeric>
 #include <random>
 
@@ -18,6 +21,7 @@
 #include "rl/classic/pendulum.hpp"
 #include "rl/dqn.hpp"
 #include "rl/learner.hpp"
+#include "rl/registry.hpp"
 #include "rl/sac.hpp"
 #include "rl/td3.hpp"
 #include "rl/train_classic.hpp"
@@ -278,26 +282,7 @@ TEST(Learning, Td3ReadsImagePlusVectorThroughTheSharedEncoder) {
   EXPECT_LT(untrained, -0.15);
 }
 
-// ---- determinism ----------------------------------------------------------------
-
-TEST(Determinism, SameSeedSameReturnsDifferentSeedDifferent) {
-  auto run = [](const std::string& algo, std::uint64_t seed) {
-    std::unique_ptr<rl::Env> env = rl::make_classic_env(algo == "dqn" ? "cartpole" : "pendulum");
-    env->seed(seed);
-    const YAML::Node config = algo == "td3" ? small_td3() : algo == "sac" ? small_sac() : small_dqn();
-    auto learner = rl::make_learner(algo, env->observation_spec(), env->action_spec(), config, "t", seed);
-    std::vector<double> returns = rl::train(*env, *learner, 1000).episode_returns;
-    for (double r : rl::evaluate(*env, *learner, 2)) returns.push_back(r);
-    return returns;
-  };
-  for (const std::string algo : {"td3", "sac", "dqn"}) {
-    const std::vector<double> a = run(algo, 11), b = run(algo, 11), c = run(algo, 12);
-    EXPECT_EQ(a, b) << algo;
-    EXPECT_NE(a, c) << algo;
-  }
-}
-
-// ---- checkpoints ----------------------------------------------------------------
+// ---- every registered learner: determinism, checkpoints, policy ----------------------
 
 namespace {
 
@@ -332,32 +317,115 @@ void expect_exact_resume(const std::string& algo, EnvT env, const YAML::Node& co
   std::filesystem::remove(path);
 }
 
+// What the tests below need of each registered learner: the classic env and
+// small config of the determinism runs, and the checkpoint cases.
+struct LearnerCase {
+  std::string classic_env;
+  YAML::Node config;
+  std::function<void(const std::string& algo)> resume;
+};
+
+const std::map<std::string, LearnerCase>& learner_cases() {
+  static const std::map<std::string, LearnerCase> cases{
+      {"td3", {"pendulum", small_td3(),
+               [](const std::string& algo) {  // images and vector, shared and separate encoders
+                 YAML::Node config = small_td3();
+                 config["batch_size"] = 16;
+                 config["learning_starts"] = 50;
+                 config["random_action_steps"] = 50;
+                 expect_exact_resume(algo, SpotEnv(false, 4), config, 120, 60);
+                 config["share_encoder"] = false;
+                 expect_exact_resume(algo, SpotEnv(false, 4), config, 120, 60);
+               }}},
+      {"sac", {"pendulum", small_sac(),
+               [](const std::string& algo) {
+                 YAML::Node config = small_sac();
+                 config["learning_starts"] = 100;
+                 config["random_action_steps"] = 100;
+                 expect_exact_resume(algo, rl::PendulumEnv(), config, 250, 150);  // saved mid-episode
+               }}},
+      {"dqn", {"cartpole", small_dqn(),
+               [](const std::string& algo) {  // images and a mask
+                 YAML::Node config = small_dqn();
+                 config["hidden_sizes"] = std::vector<int>{};
+                 config["learning_starts"] = 40;
+                 config["target_update_interval"] = 7;
+                 expect_exact_resume(algo, SpotEnv(true, 4), config, 101, 80);
+               }}}};
+  return cases;
+}
+
+class EveryLearner : public ::testing::TestWithParam<std::string> {
+ protected:
+  const LearnerCase& test_case() const {
+    const auto it = learner_cases().find(GetParam());
+    if (it == learner_cases().end()) throw std::logic_error("no test case for the registered learner " + GetParam());
+    return it->second;
+  }
+};
+
+TEST_P(EveryLearner, SameSeedSameReturnsDifferentSeedDifferent) {
+  const std::string algo = GetParam();
+  const LearnerCase& c = test_case();
+  auto run = [&](std::uint64_t seed) {
+    std::unique_ptr<rl::Env> env = rl::make_classic_env(c.classic_env);
+    env->seed(seed);
+    auto learner = rl::make_learner(algo, env->observation_spec(), env->action_spec(), c.config, "t", seed);
+    std::vector<double> returns = rl::train(*env, *learner, 1000).episode_returns;
+    for (double r : rl::evaluate(*env, *learner, 2)) returns.push_back(r);
+    return returns;
+  };
+  const std::vector<double> a = run(11), b = run(11), c2 = run(12);
+  EXPECT_EQ(a, b) << algo;
+  EXPECT_NE(a, c2) << algo;
+}
+
+TEST_P(EveryLearner, ResumesExactlyFromACheckpoint) { test_case().resume(GetParam()); }
+
+// The acting side alone: a policy of the learner's seed, synced from it, acts
+// as the learner does (greedy and exploring, same RNG stream and counters),
+// and keeps doing so through its own save and load.
+TEST_P(EveryLearner, APolicySyncedFromItsLearnerActsAsTheLearner) {
+  const std::string algo = GetParam();
+  const LearnerCase& c = test_case();
+  std::unique_ptr<rl::Env> env = rl::make_classic_env(c.classic_env);
+  rl::LearnerArgs args;
+  args.observation = env->observation_spec();
+  args.action = env->action_spec();
+  args.seed = 3;
+  args.config = rl::learner_entry(algo).read_config(c.config, "t");
+  auto learner = rl::make_learner(algo, args);
+  auto policy = rl::make_policy(algo, args);
+  policy->sync_from(*learner);
+  rl::Observation o;
+  env->seed(3);
+  env->reset(o);
+  rl::Action x, y;
+  for (int i = 0; i < 5; ++i)
+    for (bool explore : {false, true}) {
+      learner->act(o, explore, x);
+      policy->act(o, explore, y);
+      EXPECT_EQ(x.discrete, y.discrete) << algo;
+      EXPECT_EQ(x.continuous, y.continuous) << algo;
+    }
+  const std::string path = temp_path(algo + "_policy.pt");
+  policy->save(path);
+  auto loaded = rl::make_policy(algo, args);
+  loaded->load(path);
+  EXPECT_EQ(loaded->counters().transitions, policy->counters().transitions);
+  for (bool explore : {false, true}) {
+    policy->act(o, explore, x);
+    loaded->act(o, explore, y);
+    EXPECT_EQ(x.discrete, y.discrete) << algo;
+    EXPECT_EQ(x.continuous, y.continuous) << algo;
+  }
+  std::filesystem::remove(path);
+}
+
+INSTANTIATE_TEST_SUITE_P(Registry, EveryLearner, ::testing::ValuesIn(rl::learner_names()),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
 }  // namespace
-
-TEST(Checkpoint, Td3ResumesExactlyWithImagesAndVector) {
-  YAML::Node config = small_td3();
-  config["batch_size"] = 16;
-  config["learning_starts"] = 50;
-  config["random_action_steps"] = 50;
-  expect_exact_resume("td3", SpotEnv(false, 4), config, 120, 60);
-  config["share_encoder"] = false;
-  expect_exact_resume("td3", SpotEnv(false, 4), config, 120, 60);
-}
-
-TEST(Checkpoint, SacResumesExactlyOnPendulum) {
-  YAML::Node config = small_sac();
-  config["learning_starts"] = 100;
-  config["random_action_steps"] = 100;
-  expect_exact_resume("sac", rl::PendulumEnv(), config, 250, 150);  // saved mid-episode
-}
-
-TEST(Checkpoint, DqnResumesExactlyWithImagesAndMask) {
-  YAML::Node config = small_dqn();
-  config["hidden_sizes"] = std::vector<int>{};
-  config["learning_starts"] = 40;
-  config["target_update_interval"] = 7;
-  expect_exact_resume("dqn", SpotEnv(true, 4), config, 101, 80);
-}
 
 TEST(Checkpoint, RejectsTheWrongAlgorithm) {
   rl::PendulumEnv env;

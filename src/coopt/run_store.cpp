@@ -1,0 +1,254 @@
+#include "coopt/run_store.hpp"
+
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "common/checksum.hpp"
+#include "common/file_io.hpp"
+#include "rl/learner.hpp"
+#include "rl/policy.hpp"
+#include "rl/replay_buffer.hpp"
+
+namespace comorph::coopt {
+namespace fs = std::filesystem;
+namespace {
+
+template <class Model>
+void load_file(Model& model, const std::string& path) {
+  try {
+    model.load(path);
+  } catch (const c10::Error& e) {
+    const std::string what = e.what_without_backtrace();
+    throw std::runtime_error(path + ": cannot load: " + quote_value(what.substr(0, what.find('\n')), 200));
+  }
+}
+
+// A learner's replay from its checkpoint's segments (rl/replay_segments.hpp;
+// an older checkpoint's learner file held it, and then there is no index).
+// Every transition the learner counts must be back: a missing index would
+// otherwise resume with an empty buffer.
+rl::ReplaySegments load_replay(rl::Learner& learner, const std::string& name, const std::string& dir) {
+  rl::ReplaySegments segments = rl::read_replay_segments(learner.replay(), name, dir);
+  const rl::ReplayBuffer& replay = learner.replay();
+  const std::int64_t expected = std::min(learner.counters().transitions, replay.capacity());
+  if (replay.size() != expected)
+    throw std::runtime_error((fs::path(dir) / rl::replay_index_name(name)).string() + ": the replay holds " +
+                             std::to_string(replay.size()) + " transitions, the learner stored " +
+                             std::to_string(learner.counters().transitions) + " (capacity " +
+                             std::to_string(replay.capacity()) + ")");
+  return segments;
+}
+
+std::string first_difference(const std::string& a, const std::string& b) {
+  std::istringstream sa(a), sb(b);
+  std::string la, lb;
+  int line = 0;
+  while (true) {
+    const bool ga = static_cast<bool>(std::getline(sa, la));
+    const bool gb = static_cast<bool>(std::getline(sb, lb));
+    ++line;
+    if (!ga && !gb) return "";
+    if (!ga || !gb || la != lb)
+      return "line " + std::to_string(line) + ": checkpoint has '" + quote_value(gb ? lb : "<end>") +
+             "', config has '" + quote_value(ga ? la : "<end>") + "'";
+  }
+}
+
+}  // namespace
+
+std::string checkpoint_dir_of(const std::string& run) { return (fs::path(run) / "checkpoint").string(); }
+
+void load_learner_file(rl::Learner& learner, const std::string& path) { load_file(learner, path); }
+void load_learner_file(rl::Policy& policy, const std::string& path) { load_file(policy, path); }
+
+// ---------------------------------------------------------------------------
+
+CheckpointInfo read_checkpoint_info(const std::string& run_dir) {
+  // checkpoint/ is the newest; checkpoint.old/ the one before it (and the only
+  // one after a crash between the two renames of save_checkpoint). The first
+  // whose files all match their checksums is used; a damaged one is named.
+  std::string dir, problems;
+  for (const std::string& candidate : {checkpoint_dir_of(run_dir), checkpoint_dir_of(run_dir) + ".old"}) {
+    if (!fs::exists(candidate)) continue;
+    std::string problem;
+    if (!fs::exists(fs::path(candidate) / "trainer.yaml")) {
+      problem = candidate + ": incomplete (no trainer.yaml)";
+    } else if (!fs::exists(fs::path(candidate) / kChecksumFile)) {
+      std::fprintf(stderr, "comorph: warning: %s has no %s (written before checkpoints had checksums): not verified\n",
+                   candidate.c_str(), kChecksumFile);
+    } else {
+      problem = verify_checksums(candidate);
+    }
+    if (problem.empty()) {
+      dir = candidate;
+      break;
+    }
+    problems += (problems.empty() ? "" : "; ") + problem;
+  }
+  if (dir.empty())
+    throw std::runtime_error(problems.empty() ? run_dir + ": no checkpoint (expected " + checkpoint_dir_of(run_dir) + ")"
+                                              : problems + "; no usable checkpoint in " + run_dir);
+  if (!problems.empty()) std::fprintf(stderr, "comorph: %s; using the previous checkpoint %s\n", problems.c_str(), dir.c_str());
+  const std::string path = (fs::path(dir) / "trainer.yaml").string();
+  CheckpointInfo info;
+  try {
+    const YAML::Node n = load_yaml_file(path);
+    info.episodes = n["episodes"].as<int>();
+    info.evaluations = n["evaluations"].as<int>();
+    info.env_steps = n["env_steps"].as<std::int64_t>();
+    info.wall_s = n["wall_s"].as<double>();
+    info.config_text = n["config"].as<std::string>();
+    if (n["env_files"]) info.env_text = n["env_files"].as<std::string>();
+    info.has_env_text = static_cast<bool>(n["env_files"]);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(path + ": unreadable checkpoint: " + e.msg);
+  }
+  info.directory = dir;
+  return info;
+}
+
+void check_checkpoint_counts(const CheckpointInfo& info, const CooptConfig& config) {
+  const int total = config.trainer.total_episodes();
+  if (info.episodes < 0 || info.episodes > total)
+    throw std::runtime_error(info.directory + ": the checkpoint counts " + std::to_string(info.episodes) +
+                             " episodes, the config has " + std::to_string(total) +
+                             " (warm-up + training + DQN refit); refusing to resume");
+  if (info.evaluations < 0 || info.evaluations > info.episodes)
+    throw std::runtime_error(info.directory + ": the checkpoint counts " + std::to_string(info.evaluations) +
+                             " evaluations after " + std::to_string(info.episodes) +
+                             " episodes; refusing to resume");
+  if (info.env_steps < 0 || info.wall_s < 0)
+    throw std::runtime_error(info.directory + ": the checkpoint counts " + std::to_string(info.env_steps) +
+                             " control steps and " + std::to_string(info.wall_s) + " s; refusing to resume");
+}
+
+void check_same_run(const CheckpointInfo& info, const CooptConfig& config, const std::string& run_dir) {
+  if (info.config_text != config.text)
+    throw std::runtime_error(run_dir + ": the checkpoint was written by another configuration (" +
+                             first_difference(config.text, info.config_text) + ")");
+  if (!info.has_env_text)
+    std::fprintf(stderr, "comorph: warning: %s predates simulator-config checks: configs/sim not compared\n",
+                 info.directory.c_str());
+  else if (info.env_text != config.env_text)
+    throw std::runtime_error(run_dir + ": the simulator config (" + config.env_dir +
+                             ") changed since the checkpoint was written (" +
+                             first_difference(config.env_text, info.env_text) + ")");
+}
+
+void truncate_csv_rows(const std::string& path, int rows) {
+  if (!fs::exists(path)) return;
+  std::ifstream in(path);
+  std::string text, line;
+  int kept = -1;  // the header is row -1
+  while (kept < rows && std::getline(in, line)) {
+    text += line + "\n";
+    ++kept;
+  }
+  in.close();
+  write_file_atomic(path, text);
+}
+
+std::string RunStore::path(const std::string& name) const { return (fs::path(dir_) / name).string(); }
+
+void RunStore::save_checkpoint(TrainingState& s, const CooptConfig& config, double wall_s) const {
+  const std::string dir = checkpoint_dir_of(dir_);
+  const std::string tmp = dir + ".tmp", old = dir + ".old";
+  fs::remove_all(tmp);
+  fs::create_directories(tmp);
+  rl::ReplaySegments motion_next, config_next;
+  try {
+    write_checkpoint_files(s, config, wall_s, tmp, motion_next, config_next);
+  } catch (...) {
+    // A full disk: the last good checkpoint stays; free what the partial one took.
+    std::error_code ignored;
+    fs::remove_all(tmp, ignored);
+    try {
+      throw;
+    } catch (const c10::Error& e) {  // any other LibTorch failure: one line, no backtrace
+      const std::string what = e.what_without_backtrace();
+      throw std::runtime_error("cannot write the checkpoint " + tmp + ": " + what.substr(0, what.find('\n')));
+    }
+  }
+  // Swap directories: a crash at any point leaves either `checkpoint` or
+  // `checkpoint.old` complete (read_checkpoint_info falls back to .old).
+  // checkpoint.old stays as the fallback when `checkpoint` is found damaged.
+  // The replay segments live in each directory that needs them (hard
+  // links), so removing checkpoint.old takes nothing from the others.
+  fs::remove_all(old);
+  if (fs::exists(dir)) fs::rename(dir, old);
+  fs::rename(tmp, dir);
+  s.motion_segments = motion_next;
+  s.motion_segments.directory = dir;
+  s.config_segments = config_next;
+  s.config_segments.directory = dir;
+}
+
+// The files of a checkpoint into `tmp`, the checksums last. The replay
+// buffers go apart from their learners, as segments: only the transitions
+// added since the last checkpoint are written (rl/replay_segments.hpp).
+void RunStore::write_checkpoint_files(const TrainingState& s, const CooptConfig& config, double wall_s,
+                                      const std::string& tmp, rl::ReplaySegments& motion_next,
+                                      rl::ReplaySegments& config_next) const {
+  std::vector<std::string> files{"motion.pt", "motion_actor.pt", "trainer.yaml"};
+  std::map<std::string, std::string> sums;  // of linked segments, known without reading them
+  if (s.motion_on_policy) {  // no replay: its rollout is in its own file
+    s.motion->save((fs::path(tmp) / "motion.pt").string());
+  } else {
+    s.motion->save_without_replay((fs::path(tmp) / "motion.pt").string());
+    motion_next = rl::write_replay_segments(s.motion->replay(), "motion", tmp, s.motion_segments, files, sums);
+  }
+  s.agent.motion->save((fs::path(tmp) / "motion_actor.pt").string());  // the acting side: networks, counters, RNG
+  if (s.agent.config) {
+    s.agent.config->save_without_replay((fs::path(tmp) / "config_model.pt").string());
+    files.push_back("config_model.pt");
+    config_next =
+        rl::write_replay_segments(s.agent.config->replay(), "config_model", tmp, s.config_segments, files, sums);
+  }
+  YAML::Emitter e;
+  e << YAML::BeginMap;
+  e << YAML::Key << "episodes" << YAML::Value << s.episode;
+  e << YAML::Key << "evaluations" << YAML::Value << s.evaluations;
+  e << YAML::Key << "env_steps" << YAML::Value << s.steps;
+  e << YAML::Key << "wall_s" << YAML::Value << wall_s;
+  e << YAML::Key << "rng" << YAML::Value << rl::rng_state(s.rng);
+  // env_files ends with a newline, which a literal block keeps; config has
+  // none, which only the last value of the document keeps.
+  e << YAML::Key << "env_files" << YAML::Value << YAML::Literal << config.env_text;
+  e << YAML::Key << "config" << YAML::Value << YAML::Literal << config.text;
+  e << YAML::EndMap;
+  write_file_atomic((fs::path(tmp) / "trainer.yaml").string(), e.c_str());
+  write_checksums(tmp, files, sums);
+}
+
+void RunStore::load_checkpoint(TrainingState& s, const CooptConfig& config) const {
+  const CheckpointInfo info = read_checkpoint_info(dir_);
+  try {
+    check_same_run(info, config, dir_);
+    check_checkpoint_counts(info, config);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(std::string(e.what()) + "; refusing to resume");
+  }
+  load_learner_file(*s.motion, (fs::path(info.directory) / "motion.pt").string());
+  if (!s.motion_on_policy) s.motion_segments = load_replay(*s.motion, "motion", info.directory);
+  load_learner_file(*s.agent.motion, (fs::path(info.directory) / "motion_actor.pt").string());
+  if (s.agent.config) {
+    load_learner_file(*s.agent.config, (fs::path(info.directory) / "config_model.pt").string());
+    s.config_segments = load_replay(*s.agent.config, "config_model", info.directory);
+  }
+  const YAML::Node n = load_yaml_file((fs::path(info.directory) / "trainer.yaml").string());
+  rl::set_rng_state(s.rng, n["rng"].as<std::string>());
+  s.episode = info.episodes;
+  s.evaluations = info.evaluations;
+  s.steps = info.env_steps;
+  s.wall_before = info.wall_s;
+  truncate_csv_rows(path("episodes.csv"), s.episode);
+  truncate_csv_rows(path("evaluations.csv"), s.evaluations);
+}
+
+}  // namespace comorph::coopt

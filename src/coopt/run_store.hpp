@@ -1,0 +1,46 @@
+// The run directory: everything the trainer writes there goes through one
+// RunStore. It writes the checkpoint (checkpoint.tmp, then swapped in, the
+// previous one kept as checkpoint.old; replay buffers as segments, checksums
+// last), reads it back after checking the run's identity and counts, and cuts
+// episodes.csv and evaluations.csv back to the rows the checkpoint counted.
+// Every text file is written atomically (common/file_io.hpp). Internal to coopt;
+// the checks it applies are public in coopt/trainer.hpp.
+#pragma once
+
+#include <string>
+
+#include "coopt/config.hpp"
+#include "coopt/training_state.hpp"
+
+namespace comorph::coopt {
+
+// <run_dir>/checkpoint, the latest checkpoint's directory.
+std::string checkpoint_dir_of(const std::string& run_dir);
+
+// Loads one checkpoint file into a learner or policy. LibTorch's errors (a C++
+// backtrace of 20 lines) become one line naming the file.
+void load_learner_file(rl::Learner& learner, const std::string& path);
+void load_learner_file(rl::Policy& policy, const std::string& path);
+
+class RunStore {
+ public:
+  explicit RunStore(std::string run_dir) : dir_(std::move(run_dir)) {}
+  const std::string& dir() const { return dir_; }
+  std::string path(const std::string& name) const;  // a file of the run directory
+
+  // Writes `s` as the run's checkpoint (the caller has synced both threads);
+  // wall_s is the training wall time so far. Updates s's replay segments.
+  void save_checkpoint(TrainingState& s, const CooptConfig& config, double wall_s) const;
+  // Loads the latest usable checkpoint into `s`; throws (naming the
+  // difference; "refusing to resume") when it was written by another config or
+  // simulator config or counts impossible numbers. Then truncates the CSV files.
+  void load_checkpoint(TrainingState& s, const CooptConfig& config) const;
+
+ private:
+  void write_checkpoint_files(const TrainingState& s, const CooptConfig& config, double wall_s,
+                              const std::string& tmp, rl::ReplaySegments& motion_next,
+                              rl::ReplaySegments& config_next) const;
+  std::string dir_;
+};
+
+}  // namespace comorph::coopt

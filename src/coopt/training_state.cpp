@@ -1,0 +1,54 @@
+#include "coopt/training_state.hpp"
+
+#include <torch/torch.h>
+
+#include "coopt/segment.hpp"
+#include "rl/registry.hpp"
+
+namespace comorph::coopt {
+namespace {
+
+rl::LearnerArgs motion_args(const CooptConfig& c, std::uint64_t seed) {
+  rl::LearnerArgs a;
+  a.observation = motion_spec(c);
+  a.action = {rl::ActionKind::kContinuous, control::kActionSize};
+  a.seed = seed;
+  if (c.trainer.motion_algo == "td3") a.config = c.td3;
+  if (c.trainer.motion_algo == "sac") a.config = c.sac;
+  a.random_action_episodes = c.trainer.warmup_episodes;  // the trainer's warm-up replaces the config's
+  return a;
+}
+
+}  // namespace
+
+std::unique_ptr<rl::Learner> make_motion_learner(const CooptConfig& c, std::uint64_t seed) {
+  return rl::make_learner(c.trainer.motion_algo, motion_args(c, seed));
+}
+
+std::unique_ptr<rl::Policy> make_motion_policy(const CooptConfig& c, std::uint64_t seed) {
+  return rl::make_policy(c.trainer.motion_algo, motion_args(c, seed));
+}
+
+std::unique_ptr<rl::Learner> make_config_model(const CooptConfig& c, std::uint64_t seed) {
+  if (c.trainer.mode != "hierarchical") return nullptr;
+  rl::LearnerArgs a;
+  a.observation = config_spec(c);
+  a.action = {rl::ActionKind::kDiscrete, kCandidates};
+  a.seed = seed;
+  a.config = c.dqn;
+  return rl::make_learner("dqn", a);
+}
+
+TrainingState::TrainingState(const CooptConfig& c) : rng(c.trainer.seed * 7919ULL + 17) {
+  rl::set_torch_threads(c.trainer.torch_threads, 1);  // before the models: they run on these threads
+  const std::uint64_t seed = static_cast<std::uint64_t>(c.trainer.seed);
+  motion = make_motion_learner(c, seed);
+  motion_on_policy = rl::learner_entry(c.trainer.motion_algo).on_policy;
+  agent.motion = make_motion_policy(c, seed + 1);
+  agent.motion->sync_from(*motion);
+  agent.config = make_config_model(c, seed + 2);
+}
+
+TrainingState::~TrainingState() = default;
+
+}  // namespace comorph::coopt

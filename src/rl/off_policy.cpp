@@ -1,0 +1,103 @@
+#include "rl/off_policy.hpp"
+
+#include <torch/torch.h>
+
+#include <cmath>
+
+namespace comorph::rl {
+
+torch::Tensor gaussian_noise(std::int64_t rows, std::int64_t cols, double std, std::mt19937_64& rng,
+                             const torch::Device& device) {
+  torch::Tensor noise = torch::empty({rows, cols}, torch::kFloat32);
+  float* p = noise.data_ptr<float>();
+  std::normal_distribution<float> normal(0.0f, static_cast<float>(std));
+  for (std::int64_t i = 0; i < rows * cols; ++i) p[i] = normal(rng);
+  return noise.to(device);
+}
+
+void gradient_step(torch::optim::Optimizer& optimizer, const torch::Tensor& loss, double max_grad_norm) {
+  optimizer.zero_grad();
+  loss.backward();
+  if (max_grad_norm > 0) torch::nn::utils::clip_grad_norm_(optimizer.param_groups()[0].params(), max_grad_norm);
+  optimizer.step();
+}
+
+torch::Tensor twin_critic_step(ActorCritic& nets, torch::optim::Optimizer& optimizer, const ReplayBatch& b,
+                               const torch::Tensor& y, double max_grad_norm, double& loss) {
+  const torch::Tensor f = nets->critic_features(b.image, b.vector);
+  const torch::Tensor critic_loss = torch::mse_loss(nets->q1(f, b.action), y) + torch::mse_loss(nets->q2(f, b.action), y);
+  gradient_step(optimizer, critic_loss, max_grad_norm);
+  loss = critic_loss.item<double>();
+  return f;
+}
+
+torch::Tensor actor_features_of(ActorCritic& nets, const Observation& o, const ObservationSpec& spec,
+                                const torch::Device& device) {
+  return nets->actor_features(image_batch(o, spec, device), vector_batch(o, spec, device), {});
+}
+
+bool random_warmup_action(std::int64_t random_action_steps, std::int64_t random_action_episodes,
+                          const LearnerCounters& n, bool explore, std::mt19937_64& rng, Action& action) {
+  if (!explore || (n.transitions >= random_action_steps && n.episodes >= random_action_episodes)) return false;
+  std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
+  for (float& a : action.continuous) a = uniform(rng);
+  return true;
+}
+
+void OffPolicyLearner::store(const Observation& o, const Action& action, float reward, const Observation& next,
+                             bool terminated, bool truncated, int steps) {
+  replay_.add(o, action, reward, next, terminated,
+              static_cast<float>(std::pow(schedule_.gamma, discount_steps(steps))));
+  ++counters_.transitions;
+  if (terminated || truncated) ++counters_.episodes;
+}
+
+int OffPolicyLearner::updates_due() const {
+  if (counters_.transitions < schedule_.learning_starts) return 0;
+  return counters_.transitions % schedule_.train_frequency == 0 ? schedule_.gradient_steps : 0;
+}
+
+void OffPolicyLearner::save_to(const std::string& path, bool with_replay) const {
+  torch::serialize::OutputArchive a;
+  write_common(a, counters_, rng_, algorithm_);
+  const CheckpointParts parts = checkpoint_parts();
+  for (const auto& [key, module] : parts.modules) {
+    torch::serialize::OutputArchive part;
+    module->save(part);
+    a.write(key, part);
+  }
+  write_extra(a);
+  for (const auto& [key, optimizer] : parts.optimizers) {
+    torch::serialize::OutputArchive part;
+    optimizer->save(part);
+    a.write(key, part);
+  }
+  write_replay(a, replay_, with_replay);
+  save_archive(a, path);
+}
+
+void OffPolicyLearner::save_policy(const std::string& path) const {
+  save_policy_file(path, acting_module(), key_, counters_, rng_, algorithm_);
+}
+
+void OffPolicyLearner::load(const std::string& path) {
+  torch::serialize::InputArchive a;
+  a.load_from(path, device_);
+  read_common(a, counters_, rng_, algorithm_);
+  if (read_policy_only(a, key_, acting_module())) return;
+  const CheckpointParts parts = checkpoint_parts();
+  for (const auto& [key, module] : parts.modules) {
+    torch::serialize::InputArchive part;
+    a.read(key, part);
+    module->load(part);
+  }
+  read_extra(a);
+  for (const auto& [key, optimizer] : parts.optimizers) {
+    torch::serialize::InputArchive part;
+    a.read(key, part);
+    optimizer->load(part);
+  }
+  read_replay(a, replay_);
+}
+
+}  // namespace comorph::rl

@@ -1,0 +1,122 @@
+// The core DQN, TD3 and SAC share: one replay buffer, the counters, the RNG,
+// the device, the update schedule (learning_starts, train_frequency,
+// gradient_steps), the discount of a stored transition (gamma^k), and the
+// checkpoint files around each algorithm's own networks and optimizers. An
+// algorithm adds act(), update(), its networks and its part of a checkpoint.
+#pragma once
+
+#include <cstdint>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "rl/learner.hpp"
+#include "rl/networks.hpp"
+#include "rl/replay_buffer.hpp"
+
+namespace comorph::rl {
+
+// rows x cols Gaussian noise of standard deviation `std` on `device`, drawn
+// element by element from `rng` (a learner's or policy's own generator, so
+// that a checkpoint restores the stream).
+torch::Tensor gaussian_noise(std::int64_t rows, std::int64_t cols, double std, std::mt19937_64& rng,
+                             const torch::Device& device);
+
+// An actor-critic config's random-action warm-up (random_action_steps
+// transitions or random_action_episodes episodes): while it lasts and the
+// caller explores, fills `action` uniformly in [-1, 1] and returns true.
+bool random_warmup_action(std::int64_t random_action_steps, std::int64_t random_action_episodes,
+                          const LearnerCounters& counters, bool explore, std::mt19937_64& rng, Action& action);
+
+// One gradient step: zero_grad, backward, the gradient's L2 norm clipped to
+// max_grad_norm (0: not clipped), step; over the optimizer's own parameters.
+void gradient_step(torch::optim::Optimizer& optimizer, const torch::Tensor& loss, double max_grad_norm);
+
+// The twin critics' step of TD3 and SAC towards the targets y: MSE of Q1 and
+// Q2 at the batch's actions, one gradient_step. The critic encoder runs once
+// for both; its features of the batch are returned (the actor step reuses
+// them, detached) with the loss in `loss`.
+torch::Tensor twin_critic_step(ActorCritic& nets, torch::optim::Optimizer& optimizer, const ReplayBatch& b,
+                               const torch::Tensor& y, double max_grad_norm, double& loss);
+
+// The actor's features of one observation (TD3, SAC acting; the caller holds
+// an InferenceMode guard).
+torch::Tensor actor_features_of(ActorCritic& nets, const Observation& o, const ObservationSpec& spec,
+                                const torch::Device& device);
+
+class OffPolicyLearner : public Learner {
+ public:
+  void store(const Observation& observation, const Action& action, float reward,
+             const Observation& next_observation, bool terminated, bool truncated, int steps = 1) final;
+  int updates_due() const final;
+  void save(const std::string& path) const final { save_to(path, true); }
+  void save_without_replay(const std::string& path) const final { save_to(path, false); }
+  void load(const std::string& path) final;
+  void save_policy(const std::string& path) const final;
+  ReplayBuffer& replay() final { return replay_; }
+  const LearnerCounters& counters() const final { return counters_; }
+  const torch::nn::Module& acting_networks() const final { return acting_module(); }
+  double last_loss() const final { return last_loss_; }
+
+ protected:
+  // What every off-policy config has (DqnConfig, Td3Config, SacConfig).
+  struct Schedule {
+    double gamma = 0.99;
+    std::int64_t learning_starts = 0;
+    int train_frequency = 1;
+    int gradient_steps = 1;
+  };
+  template <class Config>
+  static Schedule schedule_of(const Config& c) {
+    return {c.gamma, c.learning_starts, c.train_frequency, c.gradient_steps};
+  }
+  // `algorithm` names the learner in its checkpoints; `networks_key` is the
+  // archive entry of its acting networks (save_policy, Policy::load).
+  template <class Config>
+  OffPolicyLearner(std::string algorithm, std::string networks_key, const ObservationSpec& observation,
+                   const ActionSpec& action, const Config& c, std::uint64_t seed)
+      : spec_(observation), device_(c.device),
+        replay_(observation, action, c.buffer_size, image_storage_from_string(c.image_storage)), rng_(seed),
+        schedule_(schedule_of(c)), algorithm_(std::move(algorithm)), key_(std::move(networks_key)) {}
+
+  // Online and target networks, built by `make` after seeding torch with the
+  // learner's seed (network initialisation); the target starts as a copy.
+  template <class Net, class Make>
+  static void build_networks(std::uint64_t seed, Net& online, Net& target, Make make) {
+    torch::manual_seed(seed);
+    online = make();
+    target = make();
+    copy_parameters(*target, *online);
+  }
+
+  // The acting networks (a module holder: const access still loads into them).
+  virtual torch::nn::Module& acting_module() const = 0;
+  // The exponent k of a stored transition's discount gamma^k, for one that
+  // lasted `steps` environment steps (DQN's discount_per: decision gives 1).
+  virtual int discount_steps(int steps) const { return steps; }
+  // The algorithm's part of a full checkpoint, between the counters and the
+  // replay: its networks (online and target) and optimizers, each under its
+  // archive key, and anything else it learns (write_extra / read_extra).
+  struct CheckpointParts {
+    std::vector<std::pair<std::string, torch::nn::Module*>> modules;
+    std::vector<std::pair<std::string, torch::optim::Optimizer*>> optimizers;
+  };
+  virtual CheckpointParts checkpoint_parts() const = 0;
+  virtual void write_extra(torch::serialize::OutputArchive&) const {}
+  virtual void read_extra(torch::serialize::InputArchive&) {}
+
+  ObservationSpec spec_;
+  torch::Device device_;
+  ReplayBuffer replay_;
+  std::mt19937_64 rng_;  // replay sampling, exploration, the algorithm's noise
+  LearnerCounters counters_;
+  double last_loss_ = 0;
+
+ private:
+  void save_to(const std::string& path, bool with_replay) const;
+  Schedule schedule_;
+  std::string algorithm_, key_;
+};
+
+}  // namespace comorph::rl

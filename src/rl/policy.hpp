@@ -1,0 +1,89 @@
+// The acting side of a learner (Stable-Baselines3's policy / algorithm split):
+// a copy of the networks that choose actions, the exploration schedule and the
+// RNG it draws from. A loop that acts on one thread and learns on another
+// holds a Policy on the acting thread and the Learner on the other; replay,
+// optimizers and target networks then exist once, and the acting copy takes
+// the learner's weights at each hand-over (sync_from).
+//
+//   auto policy = rl::make_policy("td3", args);    // rl/registry.hpp
+//   policy->sync_from(learner);                    // the learner's acting weights
+//   policy->act(obs, /*explore=*/true, action);
+//   policy->count(terminated, truncated);          // the schedule's clock, as store() counts
+#pragma once
+
+#include <torch/torch.h>
+
+#include <cstdint>
+#include <random>
+#include <string>
+
+#include "rl/env.hpp"
+#include "rl/learner.hpp"
+
+namespace comorph::rl {
+
+class Policy {
+ public:
+  virtual ~Policy() = default;
+  // As Learner::act of the same algorithm, on this copy's weights, counters and RNG.
+  virtual void act(const Observation& observation, bool explore, Action& action) = 0;
+  // One acted transition, counted as Learner::store counts it: exploration
+  // schedules (random-action warm-up, noise decay, epsilon) run on these counters.
+  void count(bool terminated, bool truncated) {
+    ++counters_.transitions;
+    if (terminated || truncated) ++counters_.episodes;
+  }
+  // Copies the learner's acting networks (Learner::acting_networks) into this copy.
+  void sync_from(const Learner& learner);
+  // Networks, counters and RNG, in Learner::save_policy's format; load() also
+  // reads a learner's full checkpoint (its networks, counters and RNG).
+  void save(const std::string& path) const;
+  void load(const std::string& path);
+  const LearnerCounters& counters() const { return counters_; }
+
+ protected:
+  // `algorithm` and `networks_key` name the checkpoint's learner and the
+  // archive entry of its acting networks; `device` is the config's.
+  Policy(std::string algorithm, std::string networks_key, std::string device, std::uint64_t seed)
+      : rng_(seed), algorithm_(std::move(algorithm)), key_(std::move(networks_key)), device_(std::move(device)) {}
+  // The acting networks (a module holder: const access still loads into them).
+  virtual torch::nn::Module& acting_module() const = 0;
+
+  LearnerCounters counters_;
+  std::mt19937_64 rng_;
+
+ private:
+  std::string algorithm_, key_, device_;
+};
+
+// The policy of DQN, TD3 and SAC: a copy of the learner's acting network
+// (Net: QNetwork, ActorCritic) and the algorithm's acting rule, the same
+// function its learner acts with (so both draw the same numbers from their RNG).
+template <class Net, class Config>
+class NetworkPolicy final : public Policy {
+ public:
+  using Rule = void (*)(Net& net, const ObservationSpec& spec, int actions, const Config& config,
+                        const torch::Device& device, const LearnerCounters& counters, std::mt19937_64& rng,
+                        const Observation& observation, bool explore, Action& action);
+  // `actions`: action dimensions (continuous) or count (discrete).
+  NetworkPolicy(std::string algorithm, std::string networks_key, const ObservationSpec& spec, int actions,
+                const Config& config, std::uint64_t seed, Net net, Rule rule)
+      : Policy(std::move(algorithm), std::move(networks_key), config.device, seed), spec_(spec), actions_(actions),
+        config_(config), device_(config.device), net_(std::move(net)), rule_(rule) {}
+  void act(const Observation& observation, bool explore, Action& action) override {
+    rule_(net_, spec_, actions_, config_, device_, counters_, rng_, observation, explore, action);
+  }
+
+ protected:
+  torch::nn::Module& acting_module() const override { return *net_.ptr(); }
+
+ private:
+  ObservationSpec spec_;
+  int actions_;
+  Config config_;
+  torch::Device device_;
+  Net net_;
+  Rule rule_;
+};
+
+}  // namespace comorph::rl
