@@ -58,7 +58,6 @@ void act_with(QNetwork& q, const ObservationSpec& spec, int num_actions, const D
 Dqn::Dqn(const ObservationSpec& observation, int num_actions, const DqnConfig& config, std::uint64_t seed)
     : OffPolicyLearner("dqn", "q", observation, {ActionKind::kDiscrete, num_actions}, config, seed),
       num_actions_(num_actions), config_(config) {
-  if (num_actions < 1) throw std::invalid_argument("Dqn: need at least one action");
   build_networks(seed, q_, q_target_, [&] { return make_network(spec_, num_actions, config); });
   optimizer_ = std::make_unique<torch::optim::Adam>(
       q_->parameters(), torch::optim::AdamOptions(config.learning_rate).eps(config.adam_epsilon));
@@ -112,9 +111,7 @@ Dqn::CheckpointParts Dqn::checkpoint_parts() const {
 
 std::unique_ptr<Policy> Dqn::policy(const ObservationSpec& observation, int num_actions, const DqnConfig& config,
                                     std::uint64_t seed) {
-  torch::manual_seed(seed);  // initialised as a learner of this seed; the weights are its learner's after a sync
-  return std::make_unique<NetworkPolicy<QNetwork, DqnConfig>>(
-      "dqn", "q", observation, num_actions, config, seed, make_network(observation, num_actions, config), &act_with);
+  return make_network_policy("dqn", "q", observation, num_actions, config, seed, &make_network, &act_with);
 }
 
 }  // namespace comorph::rl

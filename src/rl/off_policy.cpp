@@ -3,6 +3,7 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <stdexcept>
 
 namespace comorph::rl {
 
@@ -74,6 +75,13 @@ void OffPolicyLearner::save_to(const std::string& path, bool with_replay) const 
   }
   write_replay(a, replay_, with_replay);
   save_archive(a, path);
+}
+
+const ActionSpec& OffPolicyLearner::nonempty(const std::string& algorithm, const ActionSpec& action) {
+  if (action.size < 1)
+    throw std::invalid_argument(algorithm + ": need at least one action" +
+                                (action.kind == ActionKind::kContinuous ? " dimension" : ""));
+  return action;
 }
 
 void OffPolicyLearner::save_policy(const std::string& path) const {

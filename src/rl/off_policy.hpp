@@ -77,8 +77,12 @@ class OffPolicyLearner : public Learner {
   OffPolicyLearner(std::string algorithm, std::string networks_key, const ObservationSpec& observation,
                    const ActionSpec& action, const Config& c, std::uint64_t seed)
       : spec_(observation), device_(c.device),
-        replay_(observation, action, c.buffer_size, image_storage_from_string(c.image_storage)), rng_(seed),
+        replay_(observation, nonempty(algorithm, action), c.buffer_size, image_storage_from_string(c.image_storage)), rng_(seed),
         schedule_(schedule_of(c)), algorithm_(std::move(algorithm)), key_(std::move(networks_key)) {}
+
+  // `action` if it has at least one action (dimension); throws naming the
+  // algorithm otherwise, before the replay is sized by it.
+  static const ActionSpec& nonempty(const std::string& algorithm, const ActionSpec& action);
 
   // Online and target networks, built by `make` after seeding torch with the
   // learner's seed (network initialisation); the target starts as a copy.

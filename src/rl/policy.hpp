@@ -14,8 +14,10 @@
 #include <torch/torch.h>
 
 #include <cstdint>
+#include <memory>
 #include <random>
 #include <string>
+#include <utility>
 
 #include "rl/env.hpp"
 #include "rl/learner.hpp"
@@ -85,5 +87,20 @@ class NetworkPolicy final : public Policy {
   Net net_;
   Rule rule_;
 };
+
+// The policy of a learner of this `seed` built alone: torch's generator is
+// seeded as the learner's constructor seeds it, so its initial weights are the
+// learner's (they are replaced by a sync anyway). `make` builds the acting
+// network of the algorithm.
+template <class Net, class Config>
+std::unique_ptr<Policy> make_network_policy(std::string algorithm, std::string networks_key,
+                                            const ObservationSpec& spec, int actions, const Config& config,
+                                            std::uint64_t seed,
+                                            Net (*make)(const ObservationSpec&, int, const Config&),
+                                            typename NetworkPolicy<Net, Config>::Rule rule) {
+  torch::manual_seed(seed);
+  return std::make_unique<NetworkPolicy<Net, Config>>(std::move(algorithm), std::move(networks_key), spec, actions,
+                                                      config, seed, make(spec, actions, config), rule);
+}
 
 }  // namespace comorph::rl

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
 namespace comorph::rl {
 namespace {
@@ -58,7 +57,6 @@ void act_with(ActorCritic& nets, const ObservationSpec& spec, int action_dims, c
 Sac::Sac(const ObservationSpec& observation, int action_dims, const SacConfig& config, std::uint64_t seed)
     : OffPolicyLearner("sac", "networks", observation, {ActionKind::kContinuous, action_dims}, config, seed),
       action_dims_(action_dims), config_(config) {
-  if (action_dims < 1) throw std::invalid_argument("Sac: need at least one action dimension");
   build_networks(seed, nets_, target_, [&] { return make_networks(spec_, action_dims, config); });
   log_alpha_ = torch::full({1}, std::log(config.alpha),
                            torch::TensorOptions().dtype(torch::kFloat32).device(device_))
@@ -140,10 +138,7 @@ void Sac::read_extra(torch::serialize::InputArchive& a) {
 
 std::unique_ptr<Policy> Sac::policy(const ObservationSpec& observation, int action_dims, const SacConfig& config,
                                     std::uint64_t seed) {
-  torch::manual_seed(seed);  // initialised as a learner of this seed; the weights are its learner's after a sync
-  return std::make_unique<NetworkPolicy<ActorCritic, SacConfig>>(
-      "sac", "networks", observation, action_dims, config, seed, make_networks(observation, action_dims, config),
-      &act_with);
+  return make_network_policy("sac", "networks", observation, action_dims, config, seed, &make_networks, &act_with);
 }
 
 }  // namespace comorph::rl

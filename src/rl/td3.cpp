@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
 namespace comorph::rl {
 namespace {
@@ -46,7 +45,6 @@ void act_with(ActorCritic& nets, const ObservationSpec& spec, int action_dims, c
 Td3::Td3(const ObservationSpec& observation, int action_dims, const Td3Config& config, std::uint64_t seed)
     : OffPolicyLearner("td3", "networks", observation, {ActionKind::kContinuous, action_dims}, config, seed),
       action_dims_(action_dims), config_(config) {
-  if (action_dims < 1) throw std::invalid_argument("Td3: need at least one action dimension");
   build_networks(seed, nets_, target_, [&] { return make_networks(spec_, action_dims, config); });
   actor_optimizer_ = std::make_unique<torch::optim::Adam>(
       nets_->actor_parameters(), torch::optim::AdamOptions(config.actor_learning_rate));
@@ -115,10 +113,7 @@ Td3::CheckpointParts Td3::checkpoint_parts() const {
 
 std::unique_ptr<Policy> Td3::policy(const ObservationSpec& observation, int action_dims, const Td3Config& config,
                                     std::uint64_t seed) {
-  torch::manual_seed(seed);  // initialised as a learner of this seed; the weights are its learner's after a sync
-  return std::make_unique<NetworkPolicy<ActorCritic, Td3Config>>(
-      "td3", "networks", observation, action_dims, config, seed, make_networks(observation, action_dims, config),
-      &act_with);
+  return make_network_policy("td3", "networks", observation, action_dims, config, seed, &make_networks, &act_with);
 }
 
 }  // namespace comorph::rl
