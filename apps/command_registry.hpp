@@ -10,6 +10,11 @@
 
 namespace comorph::cli {
 
+// The help of every --config-dir option: its default (common/resources.hpp)
+// is looked up only when a command uses it.
+inline constexpr const char* kConfigDirHelp =
+    "directory of robot/scene/motion/task.yaml (default: configs/sim of comorph's data files)";
+
 using CommandSetup = std::function<void(CLI::App& app)>;
 
 inline std::vector<CommandSetup>& command_setups() {

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "command_registry.hpp"
+#include "common/resources.hpp"
 #include "morphology/configuration.hpp"
 #include "sim/mjcf.hpp"
 #include "sim/model.hpp"
@@ -18,7 +19,7 @@ using namespace comorph;
 // the robot the simulator would run and checks it against the configuration.
 void validate_file(const std::string& path, const std::string& config_dir) {
   const Configuration c = load_configuration(path);
-  const task::EnvConfig env = task::load_env_config(config_dir);
+  const task::EnvConfig env = task::load_env_config(given_or_resource(config_dir, "configs/sim"));
   const sim::SceneLayout neutral = sim::generate_scene(env.scene, 0, env.scene.stair_height_a, 0);
   const sim::ModelPtr model = sim::compile_mjcf(sim::build_mjcf(c, env.robot, env.scene, neutral));
   if (std::string fault = sim::model_fault(model.get(), c); !fault.empty())
@@ -40,9 +41,9 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   auto* check = config->add_subcommand(
       "validate", "check a configuration file and build its robot in the simulator; names the fault");
   static std::string path;
-  static std::string config_dir = "configs/sim";
+  static std::string config_dir;  // "": configs/sim of resource_dir()
   check->add_option("file", path, "configuration YAML")->required();
-  check->add_option("--config-dir", config_dir, "directory of robot/scene/motion/task.yaml");
+  check->add_option("--config-dir", config_dir, cli::kConfigDirHelp);
   check->callback([] { validate_file(path, config_dir); });
 }};
 

@@ -29,6 +29,7 @@
 
 #include "cli_numbers.hpp"
 #include "common/file_io.hpp"
+#include "common/resources.hpp"
 #include "command_registry.hpp"
 #include "coopt/scene_dataset.hpp"
 #include "perception/dataset.hpp"
@@ -152,7 +153,7 @@ coopt::SeedProgress seed_progress(const std::string& what) {
 }
 
 struct DatasetOptions {
-  std::string out, seeds = "1:30", config_dir = "configs/sim";
+  std::string out, seeds = "1:30", config_dir;  // "": configs/sim of resource_dir()
   int frames_per_seed = coopt::SceneDatasetParams{}.frames_per_seed;
   double run_fraction = coopt::SceneDatasetParams{}.run_fraction;
   std::uint64_t seed = 1;
@@ -165,7 +166,8 @@ void run_dataset(const DatasetOptions& o) {
   p.run_fraction = o.run_fraction;
   p.seed = o.seed;
   if (const std::string err = p.validate(); !err.empty()) throw std::runtime_error(err);
-  const comorph::task::EnvConfig env = comorph::task::load_env_config(o.config_dir);
+  const comorph::task::EnvConfig env =
+      comorph::task::load_env_config(comorph::given_or_resource(o.config_dir, "configs/sim"));
   std::cerr << fmt::format("dataset: scene seeds {}..{} ({} seeds), {} images a seed ({:.0f} % from scripted runs), "
                            "{}x{} pixels, generator seed {}\n",
                            p.first_seed, p.last_seed, p.seeds(), p.frames_per_seed, 100 * p.run_fraction,
@@ -177,7 +179,7 @@ void run_dataset(const DatasetOptions& o) {
 }
 
 struct PrepareOptions {
-  std::string out, config = "configs/perception.yaml", config_dir = "configs/sim";
+  std::string out, config, config_dir;  // "": configs/perception.yaml, configs/sim of resource_dir()
   std::string train_seeds = "1:30", eval_seeds = "1001:1010";
   // Held-out accuracy on this data plateaus after 2-3 epochs: 6 (not the
   // preset's 10) keeps `prepare` at ~1.5 min on an idle 2-core machine.
@@ -197,7 +199,9 @@ std::string json_delays(const perception::SwitchDelayReport& d, double max) {
 }
 
 
-void run_prepare(const PrepareOptions& o) {
+void run_prepare(PrepareOptions o) {
+  o.config = comorph::given_or_resource(o.config, "configs/perception.yaml");
+  o.config_dir = comorph::given_or_resource(o.config_dir, "configs/sim");
   const auto t_start = std::chrono::steady_clock::now();
   // ---- everything is checked before anything is written ----
   perception::PerceptionConfig cfg = perception::load_perception_config(o.config);
@@ -396,7 +400,7 @@ void add_classifier_subcommands(CLI::App& app) {
       ->check(cli::finite_in(0.0, 1.0));
   data->add_option("--seed", dop.seed, "generator seed (chain lengths, obstacle counts, frame picks, view poses)")
       ->check(cli::whole_in(0, kMaxSeed));
-  data->add_option("--config-dir", dop.config_dir, "directory of robot/scene/motion/task.yaml");
+  data->add_option("--config-dir", dop.config_dir, cli::kConfigDirHelp);
   data->callback([] { run_dataset(dop); });
 
   auto* prep = cls->add_subcommand(
@@ -404,7 +408,7 @@ void add_classifier_subcommands(CLI::App& app) {
                  "scripted episodes; saves everything to --out");
   static PrepareOptions po;
   prep->add_option("--out", po.out, "directory to create (must not exist or be empty)")->required();
-  prep->add_option("--config", po.config, "perception preset");
+  prep->add_option("--config", po.config, "perception preset (default: configs/perception.yaml of comorph's data files)");
   prep->add_option("--train-seeds", po.train_seeds, "scene seeds A:B (inclusive) of the training data");
   prep->add_option("--eval-seeds", po.eval_seeds,
                    "scene seeds C:D (inclusive, disjoint from the training seeds) of the held-out data and the "
@@ -417,7 +421,7 @@ void add_classifier_subcommands(CLI::App& app) {
                    "share of a seed's images from its scripted run (the rest: level views), 0..1")
       ->check(cli::finite_in(0.0, 1.0));
   prep->add_option("--seed", po.seed, "generator seed of the data and the episodes")->check(cli::whole_in(0, kMaxSeed));
-  prep->add_option("--config-dir", po.config_dir, "directory of robot/scene/motion/task.yaml");
+  prep->add_option("--config-dir", po.config_dir, cli::kConfigDirHelp);
   prep->callback([] { run_prepare(po); });
 }
 

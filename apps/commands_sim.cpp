@@ -8,6 +8,7 @@
 
 #include "cli_numbers.hpp"
 #include "command_registry.hpp"
+#include "common/resources.hpp"
 #include "sim/mjcf.hpp"
 #include "sim/model.hpp"
 #include "task/env_config.hpp"
@@ -20,7 +21,7 @@ namespace {
 using namespace comorph;
 
 struct SimOptions {
-  std::string config_dir = "configs/sim";
+  std::string config_dir;  // "": configs/sim of resource_dir()
   int modules = 4;
   double stair_height = 0;
   int obstacles = -1;
@@ -32,7 +33,9 @@ struct SimOptions {
   int shed_to = 0;
 };
 
-task::EnvConfig load_config(const std::string& dir) { return task::load_env_config(dir); }
+task::EnvConfig load_config(const std::string& dir) {
+  return task::load_env_config(given_or_resource(dir, "configs/sim"));
+}
 
 // Limits of the scene options: the stair heights of configs/sim/scene.yaml
 // (0..0.3 m) and seeds that every seed type in the scene code holds exactly.
@@ -172,7 +175,7 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   exp->add_option("--obstacles", o.obstacles, "K obstacles (-1 = scene default)")->check(cli::whole_in(-1, 50));
   exp->add_option("--seed", o.seed, "scene seed")->check(cli::whole_in(0, kMaxSeed));
   exp->add_option("--variant", o.variant, "standard | mixed");
-  exp->add_option("--config-dir", o.config_dir, "directory of robot/scene/motion/task.yaml");
+  exp->add_option("--config-dir", o.config_dir, cli::kConfigDirHelp);
   exp->callback([] { run_export(o); });
 
   auto* table = app.add_subcommand("physics-table",
@@ -180,7 +183,7 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   table->add_flag("--json", o.json, "print JSON instead of a table");
   table->add_option("--seeds", o.seeds, "evaluation seeds per row")->check(CLI::Range(1, 50));
   table->add_flag("--quick", o.quick, "only 2 and 6 modules");
-  table->add_option("--config-dir", o.config_dir, "directory of robot/scene/motion/task.yaml");
+  table->add_option("--config-dir", o.config_dir, cli::kConfigDirHelp);
   table->callback([] { run_physics_table(o); });
 
   auto* demo = app.add_subcommand("demo", "a scripted controller drives the robot through the scenario");
@@ -192,7 +195,7 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   demo->add_option("--variant", o.variant, "standard | mixed");
   demo->add_option("--shed-to", o.shed_to, "after the stairs, shed tail modules down to this many (0 = keep)")
       ->check(cli::whole_in(0, kMaxModules));
-  demo->add_option("--config-dir", o.config_dir, "directory of robot/scene/motion/task.yaml");
+  demo->add_option("--config-dir", o.config_dir, cli::kConfigDirHelp);
   demo->callback([] { run_demo(o); });
 }};
 

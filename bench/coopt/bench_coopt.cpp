@@ -8,6 +8,7 @@
 #include <chrono>
 #include <random>
 
+#include "common/resources.hpp"
 #include "rl/td3.hpp"
 #include "task/env_config.hpp"
 #include "task/multitask_env.hpp"
@@ -21,7 +22,7 @@ static double ms_since(Clock::time_point t) {
 
 int main() {
   rl::set_torch_threads(1, 1);
-  task::EnvConfig ec = task::load_env_config(std::string(COMORPH_SOURCE_DIR) + "/configs/sim");
+  task::EnvConfig ec = task::load_env_config(resource_path("configs/sim"));
   task::MultiTaskEnv env(ec);
   std::mt19937_64 rng(1);
   std::uniform_real_distribution<float> u(-1, 1);

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "common/file_io.hpp"
+#include "common/resources.hpp"
 #include "coopt/config.hpp"
 #include "coopt/trainer.hpp"
 #include "report/episode_record.hpp"
@@ -66,7 +67,7 @@ nlohmann::ordered_json shares(const coopt::TrainerTiming& t, bool learner_thread
 
 int main(int argc, char** argv) {
   CLI::App app{"Throughput of the hierarchical trainer for a preset: steps/s, each side alone, shares of wall time"};
-  std::string config_path = std::string(COMORPH_SOURCE_DIR) + "/configs/quick.yaml";
+  std::string config_path = resource_path("configs/quick.yaml");
   std::vector<std::string> sets;
   std::int64_t steps = 20000;
   bool json = false, skip_checkpoint = false;

@@ -54,13 +54,13 @@ _OPTIONS = ("modules", "stair_height")
 
 
 def default_config_dir():
-    """The simulator config env makes read: $COMORPH_CONFIG_DIR, else this
-    build's configs/sim (the one `comorph` and the trainer read by default)."""
+    """The simulator config env makes read: $COMORPH_CONFIG_DIR, else the
+    configs/sim of comorph's data files (the one `comorph` and the trainer
+    read by default; see _core.resource_dir)."""
     env = os.environ.get("COMORPH_CONFIG_DIR")
     if env:
         return env
-    from . import _build_paths
-    return os.path.join(_build_paths.SOURCE_DIR, "configs", "sim")
+    return os.path.join(_core.resource_dir(), "configs", "sim")
 
 
 def _whole(value, name, allow_none=False):

@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "common/resources.hpp"
 #include "env_core.hpp"
 #include "morphology/configuration.hpp"
 #include "report/offscreen_renderer.hpp"
@@ -583,6 +584,9 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("num_envs", &PyVectorEnv::num_envs)
       .def_property_readonly("threads", &PyVectorEnv::threads);
 
+  m.def("resource_dir", [] { return resource_dir(); },
+        "the directory of comorph's data files (configs/): $COMORPH_RESOURCES, else the first parent of this "
+        "module that holds them");
   m.def("termination_names", [] {
     std::vector<std::string> names;
     for (int t = 0; t <= static_cast<int>(task::Termination::step_cap); ++t)

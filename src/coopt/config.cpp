@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "sim/params.hpp"
+#include "common/resources.hpp"
 #include "common/yaml_fields.hpp"
 #include "rl/registry.hpp"
 
@@ -224,7 +225,7 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
   c.trainer = read_trainer(root["trainer"], src);
   c.eval = read_eval(root["eval"], src);
   const std::string env_dir =
-      c.trainer.env_dir.empty() ? std::string(COMORPH_SOURCE_DIR) + "/configs/sim" : c.trainer.env_dir;
+      c.trainer.env_dir.empty() ? resource_path("configs/sim") : c.trainer.env_dir;
   c.env = read_env(root["env"], src, env_dir);
   c.env_dir = env_dir;
   c.env_text = task::env_files_text(env_dir);

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "common/resources.hpp"
 #include "common/yaml_fields.hpp"  // load_yaml_file
 
 namespace comorph::report {
@@ -30,7 +31,7 @@ double get_or_nan(const YAML::Node& node, const std::string& key, const std::str
 
 }  // namespace
 
-std::string default_paper_reference_path() { return COMORPH_PAPER_REFERENCE; }
+std::string default_paper_reference_path() { return resource_path("configs/reference/paper-tables.yaml"); }
 
 PaperReference load_paper_reference(const std::string& path) {
   const YAML::Node root = load_yaml_file(path);  // size cap, duplicate keys

@@ -40,7 +40,7 @@ struct PaperReference {
   std::vector<std::string> notes;
 };
 
-// configs/reference/paper-tables.yaml of the source tree this was built from.
+// configs/reference/paper-tables.yaml of resource_dir() (common/resources.hpp).
 std::string default_paper_reference_path();
 
 // Throws naming the file and the offending entry when it is missing or malformed.

@@ -7,11 +7,12 @@
 #include <optional>
 #include <sstream>
 
+#include "common/resources.hpp"
 #include "rl/replay_buffer.hpp"
 
 namespace comorph::rl {
 
-std::string rl_config_dir() { return std::string(COMORPH_SOURCE_DIR) + "/configs/rl"; }
+std::string rl_config_dir() { return resource_path("configs/rl"); }
 
 void check_device_name(const std::string& name) {
   std::optional<torch::Device> device;

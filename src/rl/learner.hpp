@@ -90,7 +90,7 @@ struct LinearSchedule {
   }
 };
 
-// Where the YAML presets are: <source dir>/configs/rl.
+// Where the YAML presets are: configs/rl of resource_dir() (common/resources.hpp).
 std::string rl_config_dir();
 
 // Sets the intra-op and inter-op thread counts of torch. The inter-op count

@@ -212,4 +212,29 @@ TEST(ConfigValidate, BuildsTheRobotTheFileDescribesAndNamesTheFault) {
   fs::remove_all(dir);
 }
 
+// The data files (configs/sim, ...) are found at run time: beside the program,
+// or where COMORPH_RESOURCES says; a program that finds none says where it looked.
+TEST(Resources, FoundBesideTheProgramOrThroughTheEnvironmentAndNamedWhenMissing) {
+  const std::string dir = temp_dir("resources");
+  std::string log;
+  ASSERT_EQ(run_shell(kExe + " config chain -n 3 > " + dir + "/chain.yaml", log), 0) << log;
+  // No --config-dir: the build's own data files.
+  EXPECT_EQ(run_cli("config validate " + dir + "/chain.yaml", log), 0) << log;
+  // A copy of the program far from any data files, run from a directory without them.
+  fs::create_directories(dir + "/bin");
+  fs::copy_file(kExe, dir + "/bin/comorph");
+  const auto moved = [&](const std::string& environment) {
+    return "cd " + dir + " && " + environment + " " + dir + "/bin/comorph config validate chain.yaml";
+  };
+  EXPECT_EQ(exit_code(run_shell(moved(""), log)), 1);
+  EXPECT_NE(log.find("set COMORPH_RESOURCES"), std::string::npos) << log;
+  EXPECT_NE(log.find(dir + "/bin/comorph"), std::string::npos) << log;
+  EXPECT_EQ(run_shell(moved("COMORPH_RESOURCES=" + std::string(COMORPH_SOURCE_DIR)), log), 0) << log;
+  EXPECT_NE(log.find("valid, chain of 3 modules"), std::string::npos) << log;
+  // A COMORPH_RESOURCES without the files is named, not searched past.
+  EXPECT_EQ(exit_code(run_shell(moved("COMORPH_RESOURCES=" + dir), log)), 1);
+  EXPECT_NE(log.find("COMORPH_RESOURCES=" + dir + " does not hold configs/sim/robot.yaml"), std::string::npos) << log;
+  fs::remove_all(dir);
+}
+
 }  // namespace
