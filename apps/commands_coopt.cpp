@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli_numbers.hpp"
+#include "cli_scenario.hpp"
 #include "morphology/configuration.hpp"
 #include "command_registry.hpp"
 #include "run_steps.hpp"
@@ -32,7 +33,7 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   static std::string run, scenario = "default";
   static int episodes = 0, seed = -1, workers = 0, forced_modules = 0;
   ev->add_option("--run", run, "run directory")->required();
-  ev->add_option("--scenario", scenario, "default | obstacles7 | obstacles8 | mixed");
+  comorph::cli::add_scenario_option(ev, scenario);
   // The same ranges as the config's eval section (coopt/config.cpp).
   ev->add_option("--episodes", episodes, "episodes (default: eval.episodes of the run's config)")
       ->check(comorph::cli::whole_in(1, 1000000));

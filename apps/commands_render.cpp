@@ -20,6 +20,7 @@
 #include <fmt/format.h>
 
 #include "cli_numbers.hpp"
+#include "cli_scenario.hpp"
 #include "command_registry.hpp"
 #include "coopt/config.hpp"
 #include "coopt/trainer.hpp"
@@ -105,9 +106,6 @@ void render_run(RenderRequest r, bool seed_given, bool stair_height_given) {
   // Everything that can fail on bad input fails before the episode runs.
   const std::string config_path = (fs::path(r.run_dir) / "config.yaml").string();
   if (!fs::exists(config_path)) throw std::runtime_error(r.run_dir + ": not a training run (no config.yaml)");
-  int obstacles = 0;
-  bool mixed = false;
-  comorph::coopt::scenario_settings(r.scenario, obstacles, mixed);
   if (seed_given && r.seed < 0) throw std::runtime_error(fmt::format("--seed {}: seeds are >= 0", r.seed));
   if (stair_height_given && !(r.stair_height_m > 0 && r.stair_height_m < 1))
     throw std::runtime_error(fmt::format("--stair-height {} m: give a height in (0, 1) m", r.stair_height_m));
@@ -161,7 +159,8 @@ void render_run(RenderRequest r, bool seed_given, bool stair_height_given) {
   r.options.camera.track_body = "module1";  // the chain's root body: the robot stays centred
   r.options.video.fps = 1.0 / (config.env.robot.control_period * r.frame_step);
   std::string run_strip = fmt::format("render-{}", r.seed);
-  if (r.scenario != "default") run_strip += "-" + r.scenario;
+  if (comorph::task::scenario_named(r.scenario).value != comorph::task::Scenario::standard)
+    run_strip += "-" + r.scenario;
   if (stair_height_given) run_strip += fmt::format("-{:.3g}m", r.stair_height_m);
   run_strip = (fs::path(r.run_dir) / (run_strip + ".png")).string();
 
@@ -188,8 +187,7 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
                      "episode seed; eval.seed + i is evaluation episode i (default: eval.seed, episode 0)");
   auto* height = render->add_option("--stair-height", request.stair_height_m, "stair height, m (default: the episode's)")
                      ->check(comorph::cli::finite_in(0, 0.3));
-  render->add_option("--scenario", request.scenario, "default | obstacles7 | obstacles8 | mixed")
-      ->capture_default_str();
+  comorph::cli::add_scenario_option(render, request.scenario)->capture_default_str();
   render->add_option("--out,-o", request.out, "video file (.mp4); the strip goes to <out>-strip.png")->required();
   render->add_option("--width", request.options.width, "frame width, pixels")
       ->capture_default_str()

@@ -109,7 +109,7 @@ void run_demo(const SimOptions& o) {
   std::cout << fmt::format(
       "demo: {} modules, seed {}, stairs 3 x {:.2f} m, {} obstacles ({}), target at ({:.2f}, {:.2f}) m, "
       "start distance {:.2f} m\n",
-      o.modules, o.seed, s.stair_height, s.obstacles.size(), sim::variant_name(s.variant), s.target_x,
+      o.modules, o.seed, s.stair_height, s.obstacles.size(), comorph::name_of(s.variant), s.target_x,
       s.target_y, env.metrics().initial_distance_m);
   task::ScriptedPilot pilot;
   // The stair gait the physics-table search picks (full amplitude, wave lag -0.5).

@@ -208,13 +208,14 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
     write_file_atomic((fs::path(run_dir) / "config.yaml").string(), config.text + "\n");
     comorph::report::RunInfo info;
     info.name = fs::path(run_dir).filename().string();
-    info.kind = config.trainer.mode;
-    info.modules = config.trainer.mode == "fixed" ? config.trainer.fixed_modules : comorph::kMaxModules;
+    info.kind = comorph::name_of(config.trainer.mode);
+    info.modules =
+        config.trainer.mode == comorph::coopt::TrainerMode::fixed ? config.trainer.fixed_modules : comorph::kMaxModules;
     info.algo = config.trainer.motion_algo;
-    info.scenario = config.trainer.scenario;
+    info.scenario = comorph::name_of(config.trainer.scenario);
     info.episodes = config.trainer.total_episodes();
     info.preset = config.preset;
-    info.notes = "scene source: " + config.trainer.scene_source;
+    info.notes = "scene source: " + comorph::name_of(config.trainer.scene_source);
     comorph::report::write_run_info((fs::path(run_dir) / "run.yaml").string(), info);
     comorph::report::write_episodes_csv(episodes_csv, {});
     write_file_atomic(evaluations_csv, kEvalColumns);
@@ -243,9 +244,6 @@ report::Metrics eval_run(const std::string& run_dir, const std::string& scenario
   const std::string path = (fs::path(run_dir) / "config.yaml").string();
   if (!fs::exists(path)) throw std::runtime_error(run_dir + ": not a training run (no config.yaml)");
   const CooptConfig config = comorph::coopt::load_coopt_config(path);
-  int obstacles = 0;
-  bool mixed = false;
-  comorph::coopt::scenario_settings(scenario, obstacles, mixed);  // throws on a bad name
   comorph::coopt::EvalRequest request;
   request.scenario = scenario;
   request.episodes = episodes > 0 ? episodes : config.eval.episodes;

@@ -47,7 +47,7 @@ except ImportError:  # the same surface without Gymnasium
 
 ENV_ID = "comorph/MultiTask-v0"
 TERMINATIONS = tuple(_core.termination_names())  # info["termination"] values; VectorEnv's info["reason"] indexes it
-# The scenarios of `comorph eval --scenario` (coopt::scenario_settings; a test checks
+# The scenarios of `comorph eval --scenario` (task::kScenarios; a test checks
 # they agree): name -> (obstacles K or None for the scene's default, mixed variant).
 SCENARIOS = {"default": (None, False), "obstacles7": (7, False), "obstacles8": (8, False), "mixed": (None, True)}
 _OPTIONS = ("modules", "stair_height")

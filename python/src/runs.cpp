@@ -84,9 +84,6 @@ class Run {
 // episodes <= 0, seed < 0: the run config's eval section, as `comorph eval`.
 std::string evaluate(const std::string& run_dir, int episodes, int seed, const std::string& scenario, int workers) {
   const coopt::CooptConfig config = load_run_config(run_dir);
-  int obstacles = 0;
-  bool mixed = false;
-  coopt::scenario_settings(scenario, obstacles, mixed);  // a bad name throws before the checkpoint loads
   coopt::EvalRequest request;
   request.scenario = scenario;
   request.episodes = episodes > 0 ? episodes : config.eval.episodes;  // as `comorph eval`: 0 = the config's
@@ -113,15 +110,13 @@ PYBIND11_MODULE(_runs, m) {
       .def_property_readonly("hierarchical", &Run::hierarchical)
       .def_property_readonly("path", &Run::dir)
       .def_property_readonly("config_text", [](const Run& r) { return r.config().text; })
-      .def_property_readonly("scenario", [](const Run& r) { return r.config().trainer.scenario; })
+      .def_property_readonly("scenario", [](const Run& r) { return name_of(r.config().trainer.scenario); })
       .def_property_readonly("eval_seed", [](const Run& r) { return r.config().eval.seed; })
       .def_property_readonly("eval_episodes", [](const Run& r) { return r.config().eval.episodes; });
   m.def("evaluate", &evaluate, py::arg("path"), py::arg("episodes"), py::arg("seed"), py::arg("scenario"),
         py::arg("workers"));
   m.def("scenario_settings", [](const std::string& name) {
-    int obstacles = 0;
-    bool mixed = false;
-    coopt::scenario_settings(name, obstacles, mixed);
-    return py::make_tuple(obstacles, mixed);
+    const task::ScenarioSpec& s = task::scenario_named(name);
+    return py::make_tuple(s.obstacles, s.variant == sim::Variant::mixed);
   });
 }

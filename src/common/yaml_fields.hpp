@@ -5,14 +5,17 @@
 //   YamlFields f("configs/sim/robot.yaml");
 //   f.add("wheel_radius", &p.wheel_radius, 0.01, 1.0);  // number with a range
 //   f.add("device", &p.device);                         // any yaml-cpp type
+//   f.add("loss", &p.loss);                             // enum, by name (enum_names.hpp)
 //   f.apply(root);  // or f.apply_text(text)
 //
 // Dotted names ("stair.w1") bind keys of nested mappings. Errors are
-// std::runtime_error "<source>: field '<name>': <what>".
+// std::runtime_error "<source>: field '<name>': <what>"; an unknown enum name
+// is "'<value>' is not one of <name> | <name> ...".
 #pragma once
 
 #include <yaml-cpp/yaml.h>
 
+#include "common/enum_names.hpp"
 #include "common/file_io.hpp"  // read_text_file, quote_value
 
 #include <functional>
@@ -28,7 +31,8 @@ class YamlFields {
  public:
   explicit YamlFields(std::string source) : source_(std::move(source)) {}
 
-  // A field of any type yaml-cpp converts (numbers, bool, strings, lists).
+  // A field of any type yaml-cpp converts (numbers, bool, strings, lists), or
+  // an enum with a names table, given by name.
   template <typename T>
   void add(const std::string& name, T* value) {
     fields_.push_back({name, [this, value](const YAML::Node& node, const std::string& key) {
@@ -63,10 +67,18 @@ class YamlFields {
  private:
   template <typename T>
   T convert(const YAML::Node& node, const std::string& key) const {
-    try {
-      return node.as<T>();
-    } catch (const YAML::Exception&) {
-      fail(key, "bad value '" + quote_value(YAML::Dump(node)) + "'");
+    if constexpr (std::is_enum_v<T>) {
+      T v{};
+      if (!node.IsScalar() || !enum_from_name(node.Scalar(), v))
+        fail(key, "'" + quote_value(node.IsScalar() ? node.Scalar() : YAML::Dump(node)) + "' is not one of " +
+                      enum_name_list<T>());
+      return v;
+    } else {
+      try {
+        return node.as<T>();
+      } catch (const YAML::Exception&) {
+        fail(key, "bad value '" + quote_value(YAML::Dump(node)) + "'");
+      }
     }
   }
 

@@ -59,28 +59,6 @@ void check_keys(const YAML::Node& node, const std::string& source, const std::st
   }
 }
 
-template <typename T>
-void read_scalar(const YAML::Node& section, const std::string& source, const std::string& prefix,
-                 const std::string& key, T& field) {
-  const YAML::Node v = section[key];
-  if (!v) return;
-  if (!v.IsScalar()) fail(source, prefix + "." + key, "expected a scalar");
-  try {
-    field = v.as<T>();
-  } catch (const YAML::Exception&) {
-    fail(source, prefix + "." + key, "bad value '" + quote_value(v.Scalar()) + "'");
-  }
-}
-
-void one_of(const std::string& source, const std::string& key, const std::string& value,
-            const std::vector<std::string>& allowed) {
-  for (const auto& a : allowed)
-    if (a == value) return;
-  std::string list;
-  for (const auto& a : allowed) list += (list.empty() ? "" : " | ") + a;
-  fail(source, key, "'" + quote_value(value) + "' is not one of " + list);
-}
-
 std::string dump(const YAML::Node& n) {
   if (!n || n.IsNull()) return "";
   YAML::Emitter e;
@@ -91,29 +69,10 @@ std::string dump(const YAML::Node& n) {
 TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   TrainerParams p;
   const std::string pre = "trainer";
-  check_keys(n, source, pre,
-             {"mode", "fixed_modules", "motion_algo", "seed", "warmup_episodes", "episodes", "sync_interval",
-              "learner_thread", "torch_threads", "motion_image", "config_vector", "scene_source",
-              "motion_clearance", "normalize_state", "decision_camera", "warmup_policy", "warmup_noise",
-              "scripted_interval", "pilot_random_configs", "pilot_gait_per_modules", "pilot_labels",
-              "greedy_motion_interval", "config_learns_from", "config_target",
-              "config_refit_episodes",
-              "classifier_dir", "scenario", "stair_height", "eval_interval", "eval_episodes", "eval_seed",
-              "checkpoint_interval", "progress_interval", "env_dir"});
-  if (!n || n.IsNull()) return p;
-  // Numbers with ranges through YamlFields (names the key and the range).
   YamlFields f(source);
-  YAML::Node numbers(YAML::NodeType::Map);
-  const std::vector<std::string> strings{"mode",     "motion_algo", "scene_source", "classifier_dir",
-                                         "scenario", "env_dir",     "warmup_policy", "config_learns_from",
-                                         "config_target"};
-  for (const auto& kv : n) {
-    const std::string k = kv.first.as<std::string>();
-    bool is_string = false;
-    for (const auto& s : strings) is_string = is_string || s == k;
-    if (!is_string) numbers[k] = kv.second;
-  }
+  f.add(pre + ".mode", &p.mode);
   f.add(pre + ".fixed_modules", &p.fixed_modules, kMinModules, kMaxModules);
+  f.add(pre + ".motion_algo", &p.motion_algo);
   f.add(pre + ".seed", &p.seed, 0, 2000000000);
   f.add(pre + ".warmup_episodes", &p.warmup_episodes, 0, 10000000);
   f.add(pre + ".episodes", &p.episodes, 0, 10000000);
@@ -125,30 +84,27 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   f.add(pre + ".motion_clearance", &p.motion_clearance);
   f.add(pre + ".normalize_state", &p.normalize_state);
   f.add(pre + ".decision_camera", &p.decision_camera);
+  f.add(pre + ".warmup_policy", &p.warmup_policy);
   f.add(pre + ".warmup_noise", &p.warmup_noise, 0.0, 2.0);
   f.add(pre + ".scripted_interval", &p.scripted_interval, 0, 10000000);
   f.add(pre + ".pilot_random_configs", &p.pilot_random_configs);
   f.add(pre + ".pilot_gait_per_modules", &p.pilot_gait_per_modules);
   f.add(pre + ".pilot_labels", &p.pilot_labels);
   f.add(pre + ".greedy_motion_interval", &p.greedy_motion_interval, 0, 10000000);
+  f.add(pre + ".config_learns_from", &p.config_learns_from);
+  f.add(pre + ".config_target", &p.config_target);
   f.add(pre + ".config_refit_episodes", &p.config_refit_episodes, 0, 10000000);
+  f.add(pre + ".scene_source", &p.scene_source);
+  f.add(pre + ".classifier_dir", &p.classifier_dir);
+  f.add(pre + ".scenario", &p.scenario);
   f.add(pre + ".stair_height", &p.stair_height, 0, 0.5);
   f.add(pre + ".eval_interval", &p.eval_interval, 0, 10000000);
   f.add(pre + ".eval_episodes", &p.eval_episodes, 1, 100000);
   f.add(pre + ".eval_seed", &p.eval_seed, 0, 2000000000);
   f.add(pre + ".checkpoint_interval", &p.checkpoint_interval, 1, 10000000);
   f.add(pre + ".progress_interval", &p.progress_interval, 1, 10000000);
-  f.apply(numbers, pre + ".");
-  for (const auto& s : strings) read_scalar(n, source, pre, s, s == "mode" ? p.mode
-                                                               : s == "motion_algo" ? p.motion_algo
-                                                               : s == "scene_source" ? p.scene_source
-                                                               : s == "classifier_dir" ? p.classifier_dir
-                                                               : s == "scenario" ? p.scenario
-                                                               : s == "warmup_policy" ? p.warmup_policy
-                                                               : s == "config_learns_from" ? p.config_learns_from
-                                                               : s == "config_target" ? p.config_target
-                                                                                 : p.env_dir);
-  one_of(source, pre + ".mode", p.mode, {"hierarchical", "fixed"});
+  f.add(pre + ".env_dir", &p.env_dir);
+  f.apply(n, pre + ".");
   if (!rl::has_learner(p.motion_algo) || rl::learner_entry(p.motion_algo).actions != rl::ActionKind::kContinuous) {
     std::string names;
     for (const std::string& n : rl::learner_names())
@@ -156,19 +112,14 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
     fail(source, pre + ".motion_algo", "'" + quote_value(p.motion_algo) + "' is not one of " + names +
                                            " (the registered learners of continuous actions)");
   }
-  one_of(source, pre + ".scene_source", p.scene_source, {"ground_truth", "classifier"});
-  one_of(source, pre + ".scenario", p.scenario, {"default", "obstacles7", "obstacles8", "mixed"});
-  one_of(source, pre + ".warmup_policy", p.warmup_policy, {"random", "scripted"});
-  one_of(source, pre + ".config_learns_from", p.config_learns_from, {"all", "model", "greedy"});
-  one_of(source, pre + ".config_target", p.config_target, {"bootstrap", "return"});
-  if (p.config_learns_from == "greedy" && p.greedy_motion_interval < 1)
+  if (p.config_learns_from == ConfigLearnsFrom::greedy && p.greedy_motion_interval < 1)
     fail(source, pre + ".config_learns_from", "greedy needs trainer.greedy_motion_interval >= 1");
   // A run without a single episode would end at once with no checkpoint to resume or evaluate.
   if (p.warmup_episodes + p.episodes < 1)
     fail(source, pre + ".episodes", "warmup_episodes + episodes must be at least 1");
-  if (p.config_refit_episodes > 0 && p.mode != "hierarchical")
+  if (p.config_refit_episodes > 0 && p.mode != TrainerMode::hierarchical)
     fail(source, pre + ".config_refit_episodes", "needs trainer.mode hierarchical (a fixed chain has no DQN)");
-  if (p.scene_source == "classifier") {
+  if (p.scene_source == SceneSourceKind::classifier) {
     if (p.classifier_dir.empty())
       fail(source, pre + ".classifier_dir", "scene_source: classifier needs the directory of a trained classifier");
     if (!std::filesystem::exists(std::filesystem::path(p.classifier_dir) / "classifier.pt"))
@@ -202,16 +153,6 @@ task::EnvConfig read_env(const YAML::Node& n, const std::string& source, const s
 
 }  // namespace
 
-void scenario_settings(const std::string& scenario, int& obstacles, bool& mixed) {
-  mixed = false;
-  obstacles = -1;
-  if (scenario == "default") return;
-  if (scenario == "obstacles7") obstacles = 7;
-  else if (scenario == "obstacles8") obstacles = 8;
-  else if (scenario == "mixed") mixed = true;
-  else throw std::runtime_error("unknown scenario '" + quote_value(scenario) + "' (default | obstacles7 | obstacles8 | mixed)");
-}
-
 CooptConfig coopt_config_from_text(const std::string& text, const std::string& source,
                                    const std::vector<std::string>& sets) {
   YAML::Node root = parse_yaml(text, source);  // also refuses a key given twice
@@ -232,7 +173,7 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
   c.perception = perception::perception_config_from_yaml(root["perception"], src + ": perception");
   if (const std::string e = c.perception.switch_detector.validate(); !e.empty())
     throw std::runtime_error(src + ": perception.switch_detector: " + e);
-  if (c.trainer.scene_source == "classifier" &&
+  if (c.trainer.scene_source == SceneSourceKind::classifier &&
       c.perception.classifier.image_size != c.env.robot.depth_width)
     throw std::runtime_error(src + ": perception.classifier.image_size must equal env.robot.depth_width");
   if (c.env.robot.depth_width != c.env.robot.depth_height)
@@ -249,7 +190,7 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
   };
   if (c.trainer.motion_algo == "td3" || c.trainer.motion_algo == "sac")  // the typed sections; others: their defaults
     require_section(c.trainer.motion_algo, "trainer.motion_algo " + c.trainer.motion_algo, "motion model");
-  if (c.trainer.mode == "hierarchical") require_section("dqn", "trainer.mode hierarchical", "configuration model");
+  if (c.trainer.mode == TrainerMode::hierarchical) require_section("dqn", "trainer.mode hierarchical", "configuration model");
   const auto given = [&](const char* name) { return root[name] && !root[name].IsNull(); };
   c.td3 = rl::Td3Config::from_yaml(root["td3"], src + ": td3");
   c.sac = rl::SacConfig::from_yaml(root["sac"], src + ": sac");

@@ -18,16 +18,44 @@
 #include <string>
 #include <vector>
 
+#include "common/enum_names.hpp"
 #include "perception/perception_config.hpp"
 #include "rl/learner_params.hpp"
 #include "task/env_config.hpp"
+#include "task/scenario.hpp"
 
 namespace comorph::coopt {
 
+// The trainer's choices (TrainerParams says what each means) and their names.
+enum class TrainerMode { hierarchical, fixed };
+enum class WarmupPolicy { random, scripted };
+enum class ConfigLearnsFrom { all, model, greedy };
+enum class ConfigTarget { bootstrap, episode_return };    // "return" is a C++ keyword
+enum class SceneSourceKind { ground_truth, classifier };  // (SceneSource gives the labels)
+constexpr auto enum_names(TrainerMode) {
+  return std::array{EnumName{TrainerMode::hierarchical, "hierarchical"}, EnumName{TrainerMode::fixed, "fixed"}};
+}
+constexpr auto enum_names(WarmupPolicy) {
+  return std::array{EnumName{WarmupPolicy::random, "random"}, EnumName{WarmupPolicy::scripted, "scripted"}};
+}
+constexpr auto enum_names(ConfigLearnsFrom) {
+  return std::array{EnumName{ConfigLearnsFrom::all, "all"}, EnumName{ConfigLearnsFrom::model, "model"},
+                    EnumName{ConfigLearnsFrom::greedy, "greedy"}};
+}
+constexpr auto enum_names(ConfigTarget) {
+  return std::array{EnumName{ConfigTarget::bootstrap, "bootstrap"}, EnumName{ConfigTarget::episode_return, "return"}};
+}
+constexpr auto enum_names(SceneSourceKind) {
+  return std::array{EnumName{SceneSourceKind::ground_truth, "ground_truth"},
+                    EnumName{SceneSourceKind::classifier, "classifier"}};
+}
+
 struct TrainerParams {
-  std::string mode = "hierarchical";  // hierarchical (DQN picks the chain) | fixed (fixed_modules, no DQN)
+  TrainerMode mode = TrainerMode::hierarchical;  // hierarchical (DQN picks the chain) | fixed (fixed_modules, no DQN)
   int fixed_modules = 4;              // chain length of the fixed baseline, 2..10
-  std::string motion_algo = "td3";    // motion learner: td3 | sac
+  // Motion learner: a name in rl's learner registry (td3 | sac, or one a
+  // program registers), so it stays a string.
+  std::string motion_algo = "td3";
   int seed = 1;                       // seeds learners, trainer RNG and the training scenes
   int warmup_episodes = 300;          // episodes of uniform random actions (both models) before learning acts
   int episodes = 4000;                // training episodes after the warm-up
@@ -48,7 +76,7 @@ struct TrainerParams {
   // paper) or "scripted" (task::ScriptedPilot, which plans on the true obstacle
   // layout, plus Gaussian noise): demonstrations in the replay, marked as such.
   // The models never see what the pilot knows; they learn from its transitions.
-  std::string warmup_policy = "random";
+  WarmupPolicy warmup_policy = WarmupPolicy::random;
   double warmup_noise = 0.2;          // std of the noise on the pilot's actions (action units)
   int scripted_interval = 0;          // after the warm-up, every this-many-th episode is the pilot's too (0 = none)
   // Those later pilot episodes choose their configurations uniformly, as the
@@ -67,7 +95,7 @@ struct TrainerParams {
   // the policy that is evaluated: the pilot climbs with chains the model
   // cannot drive yet, and the exploring model with chains the greedy one
   // cannot (3 modules at 0.06 m: 40 of 43 exploring, 0 of 10 greedy).
-  std::string config_learns_from = "all";
+  ConfigLearnsFrom config_learns_from = ConfigLearnsFrom::all;
   // The DQN's target for a decision: bootstrap (Eq. 3: R2 + gamma max Q(s'))
   // | return (the R2 of this and every later segment of the episode, each
   // later one discounted once more by dqn.gamma, stored as terminal). The
@@ -75,7 +103,7 @@ struct TrainerParams {
   // image cannot tell apart: a longer chain's head is farther along when the
   // stairs segment ends (one module length, 16 of R1, per module) and the rest
   // of the course is shorter by as much, which bootstrapping does not see.
-  std::string config_target = "bootstrap";
+  ConfigTarget config_target = ConfigTarget::bootstrap;
   // After the training episodes, this many more in which the motion model is
   // frozen and greedy and a fresh DQN (the dqn: section, its own epsilon
   // schedule) learns from every decision. Its values then describe the final
@@ -87,9 +115,10 @@ struct TrainerParams {
   // behaviour-cloning target (td3.bc_weight), also where the motion model drove:
   // the pilot labels the states the learner visits (DAgger, Ross et al. 2011).
   bool pilot_labels = false;
-  std::string scene_source = "ground_truth";  // ground_truth (simulator labels) | classifier (ResNet-18 on depth)
+  // ground_truth (simulator labels) | classifier (ResNet-18 on depth)
+  SceneSourceKind scene_source = SceneSourceKind::ground_truth;
   std::string classifier_dir;         // trained classifier directory (scene_source: classifier)
-  std::string scenario = "default";   // training scene: default | obstacles7 | obstacles8 | mixed
+  task::Scenario scenario = task::Scenario::standard;  // training scene: a row of task::kScenarios ("default")
   double stair_height = 0;            // m; 0 = drawn per episode from {0.04, 0.06, 0.08}; > 0 fixed (reduced tasks)
   int eval_interval = 100;            // training episodes between periodic greedy evaluations (0 = none)
   int eval_episodes = 6;              // episodes per periodic evaluation (heights cycle 0.04, 0.06, 0.08)
@@ -131,8 +160,5 @@ CooptConfig load_coopt_config(const std::string& path, const std::vector<std::st
 // The same from YAML text (source names it in errors).
 CooptConfig coopt_config_from_text(const std::string& text, const std::string& source,
                                    const std::vector<std::string>& sets = {});
-
-// Scenario name -> obstacles (K; -1 = scene default) and mixed variant flag; throws if unknown.
-void scenario_settings(const std::string& scenario, int& obstacles, bool& mixed);
 
 }  // namespace comorph::coopt

@@ -63,19 +63,18 @@ void allocate_buffers(const CooptConfig& c, Buffers& b) {
   b.action.continuous.assign(control::kActionSize, 0.0f);
 }
 
-task::EpisodeSpec eval_spec(const CooptConfig& c, const std::string& scenario, std::uint64_t seed, int i) {
+task::EpisodeSpec eval_spec(const CooptConfig& c, const task::ScenarioSpec& scenario, std::uint64_t seed, int i) {
   task::EpisodeSpec spec;
   spec.seed = seed;
   const double heights[3] = {c.env.scene.stair_height_a, c.env.scene.stair_height_b, c.env.scene.stair_height_c};
   spec.stair_height = c.trainer.stair_height > 0 ? c.trainer.stair_height : heights[i % 3];
-  bool mixed = false;
-  scenario_settings(scenario, spec.obstacles, mixed);
-  spec.variant = mixed ? sim::Variant::mixed : sim::Variant::standard;
+  spec.obstacles = scenario.obstacles;
+  spec.variant = scenario.variant;
   return spec;
 }
 
 SceneSource::SceneSource(const CooptConfig& c) : params_(c.perception.switch_detector), detector_(params_, 0, 3) {
-  if (c.trainer.scene_source == "classifier") {
+  if (c.trainer.scene_source == SceneSourceKind::classifier) {
     classifier_ = std::make_unique<perception::SceneClassifier>(
         perception::SceneClassifier::load(c.trainer.classifier_dir, &c.perception.classifier));
     monitor_ = std::make_unique<perception::SceneMonitor>(*classifier_, params_, 0);
@@ -283,7 +282,7 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
 
   const task::Metrics m = env.metrics();
   log.seed = spec.seed;
-  log.scenario = c.trainer.scenario;
+  log.scenario = name_of(c.trainer.scenario);
   log.stair_height_m = env.stair_height();
   log.obstacles = static_cast<int>(env.world().layout().obstacles.size());
   log.success = r->reason == task::Termination::success;

@@ -73,7 +73,7 @@ void fill_config_vector(const TrainerParams& t, const Configuration& current, in
                         std::vector<std::uint8_t>& mask, rl::Observation& o);
 
 // The scene spec of evaluation episode i (heights cycle 0.04, 0.06, 0.08).
-task::EpisodeSpec eval_spec(const CooptConfig& c, const std::string& scenario, std::uint64_t seed, int i);
+task::EpisodeSpec eval_spec(const CooptConfig& c, const task::ScenarioSpec& scenario, std::uint64_t seed, int i);
 
 // Scene source: the switch detector on ground-truth labels or on the classifier.
 class SceneSource {

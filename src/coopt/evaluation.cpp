@@ -50,11 +50,11 @@ struct GreedyPlayer {
   }
 
   // Episode `index` of an evaluation of `scenario` (spec from eval_spec).
-  EpisodeLog play_episode(const std::string& scenario, const task::EpisodeSpec& spec, int index,
+  EpisodeLog play_episode(const task::ScenarioSpec& scenario, const task::EpisodeSpec& spec, int index,
                           const StepObserver* observe = nullptr) {
     EpisodeLog log = runner.play(agent, spec, false, nullptr, observe);
     log.episode = index;
-    log.scenario = scenario;
+    log.scenario = scenario.name;
     return log;
   }
 };
@@ -63,6 +63,7 @@ struct GreedyPlayer {
 
 std::vector<EpisodeLog> evaluate(const CooptConfig& run_config, const std::string& run_dir,
                                  const EvalRequest& request) {
+  const task::ScenarioSpec& scenario = task::scenario_named(request.scenario);
   const CheckpointInfo info = open_checkpoint_for_evaluation(run_config, run_dir);
   CooptConfig config = run_config;  // the identity (text) stays the run's
   if (request.forced_modules != 0) {
@@ -70,7 +71,7 @@ std::vector<EpisodeLog> evaluate(const CooptConfig& run_config, const std::strin
       throw std::invalid_argument("evaluate: forced chain of " + std::to_string(request.forced_modules) +
                                   " modules, not in [" + std::to_string(kMinModules) + ", " +
                                   std::to_string(kMaxModules) + "]");
-    config.trainer.mode = "fixed";  // play() then drives make_chain(fixed_modules) and no DQN is loaded
+    config.trainer.mode = TrainerMode::fixed;  // play() then drives make_chain(fixed_modules) and no DQN is loaded
     config.trainer.fixed_modules = request.forced_modules;
   }
   std::vector<EpisodeLog> logs(static_cast<std::size_t>(request.episodes));
@@ -81,8 +82,8 @@ std::vector<EpisodeLog> evaluate(const CooptConfig& run_config, const std::strin
     try {
       GreedyPlayer player(config, info);
       for (int i = next++; i < request.episodes; i = next++) {
-        const auto spec = eval_spec(config, request.scenario, static_cast<std::uint64_t>(request.seed) + i, i);
-        logs[static_cast<std::size_t>(i)] = player.play_episode(request.scenario, spec, i);
+        const auto spec = eval_spec(config, scenario, static_cast<std::uint64_t>(request.seed) + i, i);
+        logs[static_cast<std::size_t>(i)] = player.play_episode(scenario, spec, i);
       }
     } catch (...) {
       std::lock_guard<std::mutex> lock(error_mutex);
@@ -121,15 +122,13 @@ EpisodeLog play_evaluation_episode(const CooptConfig& config, const std::string&
   if (request.index < 0)
     throw std::invalid_argument("play_evaluation_episode: episode index " + std::to_string(request.index) +
                                 " < 0 (the stair height cycle starts at episode 0)");
-  int obstacles = 0;
-  bool mixed = false;
-  scenario_settings(request.scenario, obstacles, mixed);  // a bad name throws before the checkpoint loads
+  const task::ScenarioSpec& scenario = task::scenario_named(request.scenario);  // before the checkpoint loads
   const CheckpointInfo info = open_checkpoint_for_evaluation(config, run_dir);
   GreedyPlayer player(config, info);
-  task::EpisodeSpec spec = eval_spec(config, request.scenario,
+  task::EpisodeSpec spec = eval_spec(config, scenario,
                                      static_cast<std::uint64_t>(request.first_seed) + request.index, request.index);
   if (request.stair_height_m > 0) spec.stair_height = request.stair_height_m;
-  return player.play_episode(request.scenario, spec, request.index, observer ? &observer : nullptr);
+  return player.play_episode(scenario, spec, request.index, observer ? &observer : nullptr);
 }
 
 struct GreedyPolicy::Impl {

@@ -122,18 +122,18 @@ EpisodeLog Trainer::Impl::train_episode() {
       ++state.steps;
       if (!record && filled == config.trainer.sync_interval) hand_over();
     };
-  const bool scripted = !refit && t.warmup_policy == "scripted" &&
+  const bool scripted = !refit && t.warmup_policy == WarmupPolicy::scripted &&
                         (warmup || (t.scripted_interval > 0 && state.episode % t.scripted_interval == 0));
   const bool greedy_motion = refit || (!warmup && !scripted && t.greedy_motion_interval > 0 &&
                                        state.episode % t.greedy_motion_interval == 1 % t.greedy_motion_interval);
-  const bool config_learns = refit || t.config_learns_from == "all" ||
-                             (t.config_learns_from == "model" && !scripted) ||
-                             (t.config_learns_from == "greedy" && greedy_motion);
+  const bool config_learns = refit || t.config_learns_from == ConfigLearnsFrom::all ||
+                             (t.config_learns_from == ConfigLearnsFrom::model && !scripted) ||
+                             (t.config_learns_from == ConfigLearnsFrom::greedy && greedy_motion);
   hooks.motion_greedy = greedy_motion;
   hooks.config = [this, config_learns](const rl::Observation& o, const rl::Action& a, float r2,
                                        const rl::Observation& n, bool term, bool trunc, int k) {
     if (!config_learns) return;
-    if (config.trainer.config_target == "return") {
+    if (config.trainer.config_target == ConfigTarget::episode_return) {
       Transition& d = episode_decisions.emplace_back();  // 2 or 3 an episode
       d.obs = o;
       d.next = n;
@@ -176,9 +176,9 @@ EpisodeLog Trainer::Impl::train_episode() {
   task::EpisodeSpec spec;
   spec.seed = static_cast<std::uint64_t>(t.seed) * 1000003ULL + static_cast<std::uint64_t>(state.episode);
   spec.stair_height = t.stair_height;
-  bool mixed = false;
-  scenario_settings(t.scenario, spec.obstacles, mixed);
-  spec.variant = mixed ? sim::Variant::mixed : sim::Variant::standard;
+  const task::ScenarioSpec& scenario = task::scenario_spec(t.scenario);
+  spec.obstacles = scenario.obstacles;
+  spec.variant = scenario.variant;
   EpisodeLog log = runner.play(state.agent, spec, true, &hooks);
   if (!record) full_sync();
   log.episode = state.episode;
@@ -192,7 +192,7 @@ EvaluationLog Trainer::Impl::periodic_evaluation() {
   e.env_steps = state.steps;
   e.wall_s = wall();
   for (int i = 0; i < config.trainer.eval_episodes; ++i) {
-    const auto spec = eval_spec(config, config.trainer.scenario,
+    const auto spec = eval_spec(config, task::scenario_spec(config.trainer.scenario),
                                 static_cast<std::uint64_t>(config.trainer.eval_seed) + i, i);
     EpisodeLog log = runner.play(state.agent, spec, false);
     log.episode = i;

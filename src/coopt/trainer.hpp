@@ -191,7 +191,7 @@ CheckpointCost measure_checkpoint_cost(const CooptConfig& config, const std::str
 
 // `comorph eval`: greedy episodes of a trained run on the paper's protocol.
 struct EvalRequest {
-  std::string scenario = "default";  // default | obstacles7 | obstacles8 | mixed
+  std::string scenario = "default";  // a name in task::kScenarios
   int episodes = 30;                 // stair height of episode i = heights[i % 3]
   int seed = 700000;                 // seed of episode i = seed + i
   int workers = 2;                   // threads (each its own env and network copies)
@@ -218,7 +218,7 @@ std::uintmax_t export_policy(const CooptConfig& config, const std::string& run_d
 
 // One episode of an evaluation, replayed alone.
 struct EvalEpisodeRequest {
-  std::string scenario = "default";  // default | obstacles7 | obstacles8 | mixed
+  std::string scenario = "default";  // a name in task::kScenarios
   int first_seed = 700000;           // EvalRequest::seed of the evaluation
   int index = 0;                     // episode i: seed first_seed + i, stair height heights[i % 3]
   double stair_height_m = 0;         // > 0: this stair height instead (m)

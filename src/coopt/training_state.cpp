@@ -30,7 +30,7 @@ std::unique_ptr<rl::Policy> make_motion_policy(const CooptConfig& c, std::uint64
 }
 
 std::unique_ptr<rl::Learner> make_config_model(const CooptConfig& c, std::uint64_t seed) {
-  if (c.trainer.mode != "hierarchical") return nullptr;
+  if (c.trainer.mode != TrainerMode::hierarchical) return nullptr;
   rl::LearnerArgs a;
   a.observation = config_spec(c);
   a.action = {rl::ActionKind::kDiscrete, kCandidates};

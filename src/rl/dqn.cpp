@@ -94,8 +94,8 @@ void Dqn::update() {
   const ReplayBatch b = replay_.sample(config_.batch_size, rng_, device_);
   const torch::Tensor target = td_target(b);
   const torch::Tensor q = q_->forward(b.image, b.vector).gather(1, b.action.unsqueeze(1)).squeeze(1);
-  const torch::Tensor loss = config_.loss == "huber" ? torch::smooth_l1_loss(q, target)
-                                                     : torch::mse_loss(q, target);
+  const torch::Tensor loss = config_.loss == DqnLoss::huber ? torch::smooth_l1_loss(q, target)
+                                                             : torch::mse_loss(q, target);
   gradient_step(*optimizer_, loss, config_.max_grad_norm);
   last_loss_ = loss.item<double>();
   ++counters_.updates;

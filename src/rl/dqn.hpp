@@ -48,7 +48,7 @@ class Dqn final : public OffPolicyLearner {
 
  protected:
   torch::nn::Module& acting_module() const override { return *q_.ptr(); }
-  int discount_steps(int steps) const override { return config_.discount_per == "decision" ? 1 : steps; }
+  int discount_steps(int steps) const override { return config_.discount_per == DiscountPer::decision ? 1 : steps; }
   CheckpointParts checkpoint_parts() const override;
 
  private:

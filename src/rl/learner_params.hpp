@@ -54,14 +54,32 @@ void add_actor_critic_fields(YamlFields& f, ActorCriticConfig& c) {
 }
 
 // What the ranges of add_shared_learner_fields cannot say: layer widths
-// positive (a list has no range of its own), a known device and image storage.
+// positive (a list has no range of its own) and a known device.
 void check_layer_widths(const YamlFields& f, const std::vector<int>& hidden_sizes);
-void check_image_storage(const std::string& name);  // "uint8" | "float16", throws otherwise
 template <class LearnerConfig>
 void check_shared_learner_fields(const YamlFields& f, const LearnerConfig& c) {
   check_layer_widths(f, c.hidden_sizes);
   check_device_name(c.device);
-  check_image_storage(c.image_storage);
+}
+
+// The learners' choices. ImageStorage: how replay buffers keep images (value
+// * 255 rounded, or float16); checkpoints store its number, so keep the order.
+enum class ImageStorage { kUint8, kFloat16 };
+enum class DqnLoss { huber, mse };                    // DQN's loss on the TD error: smooth L1 (delta 1) or squared
+enum class DiscountPer { step, decision };            // what DQN's gamma discounts
+enum class NoiseDecayUnit { transitions, episodes };  // what TD3's exploration-noise decay counts
+constexpr auto enum_names(ImageStorage) {
+  return std::array{EnumName{ImageStorage::kUint8, "uint8"}, EnumName{ImageStorage::kFloat16, "float16"}};
+}
+constexpr auto enum_names(DqnLoss) {
+  return std::array{EnumName{DqnLoss::huber, "huber"}, EnumName{DqnLoss::mse, "mse"}};
+}
+constexpr auto enum_names(DiscountPer) {
+  return std::array{EnumName{DiscountPer::step, "step"}, EnumName{DiscountPer::decision, "decision"}};
+}
+constexpr auto enum_names(NoiseDecayUnit) {
+  return std::array{EnumName{NoiseDecayUnit::transitions, "transitions"},
+                    EnumName{NoiseDecayUnit::episodes, "episodes"}};
 }
 
 struct DqnConfig {
@@ -70,7 +88,7 @@ struct DqnConfig {
   // gamma^k (semi-MDP). "decision": with gamma once per stored transition,
   // however long it lasted (the paper's Algorithm 1, line 15); a slow segment
   // then costs only through its own rewards, not through the discount.
-  std::string discount_per = "step";
+  DiscountPer discount_per = DiscountPer::step;
   double learning_rate = 2.5e-4;        // Adam step size
   double adam_epsilon = 1e-8;           // Adam's epsilon
   int batch_size = 128;                 // transitions per update
@@ -83,13 +101,13 @@ struct DqnConfig {
   double epsilon_start = 1.0;           // exploration probability at the start
   double epsilon_end = 0.05;            // ... after the decay
   double epsilon_decay = 250000;        // transitions (store() calls) to decay over
-  std::string loss = "huber";           // "huber" (smooth L1, delta 1) or "mse"
+  DqnLoss loss = DqnLoss::huber;        // huber (smooth L1, delta 1) or mse
   double max_grad_norm = 0;             // clip the gradient's L2 norm; 0 = off
   bool double_dqn = false;              // pick the next action with the online net
   std::vector<int> hidden_sizes{120, 84};  // MLP head; [] + image-only obs = paper's net
   int image_features = 256;             // CNN output size when an MLP head follows
   int image_fc_size = 256;              // the CNN's hidden FC layer
-  std::string image_storage = "uint8";  // replay images: "uint8" or "float16"
+  ImageStorage image_storage = ImageStorage::kUint8;  // replay images: uint8 or float16
   std::string device = "cpu";           // torch device of nets and batches
 
   // Fields present in `node` override the defaults; unknown fields throw.
@@ -114,7 +132,7 @@ struct Td3Config {
   double exploration_noise_start = 0.1;  // exploration noise std at the start
   double exploration_noise_end = 0.1;    // ... after the decay
   double exploration_noise_decay = 0;    // decay length; 0 = constant `end`
-  std::string exploration_noise_unit = "transitions";  // decay counted in "transitions" or "episodes"
+  NoiseDecayUnit exploration_noise_unit = NoiseDecayUnit::transitions;  // decay counted in transitions or episodes
   double max_grad_norm = 0;              // clip gradient L2 norms; 0 = off
   // Behaviour cloning towards the demonstrator's action of the transitions that
   // carry one (Action::target; TD3+BC, Fujimoto & Gu 2021):
@@ -126,7 +144,7 @@ struct Td3Config {
   int image_features = 16;               // CNN output size (paper: 16)
   int image_fc_size = 256;               // the CNN's hidden FC layer
   bool share_encoder = true;             // actor uses the critic encoder's features (detached)
-  std::string image_storage = "uint8";   // replay images: "uint8" or "float16"
+  ImageStorage image_storage = ImageStorage::kUint8;  // replay images: uint8 or float16
   std::string device = "cpu";            // torch device of nets and batches
 
   static Td3Config from_yaml(const YAML::Node& node, const std::string& source);
@@ -157,7 +175,7 @@ struct SacConfig {
   int image_features = 16;               // CNN output size
   int image_fc_size = 256;               // the CNN's hidden FC layer
   bool share_encoder = true;             // actor uses the critic encoder's features (detached)
-  std::string image_storage = "uint8";   // replay images: "uint8" or "float16"
+  ImageStorage image_storage = ImageStorage::kUint8;  // replay images: uint8 or float16
   std::string device = "cpu";            // torch device of nets and batches
 
   static SacConfig from_yaml(const YAML::Node& node, const std::string& source);

@@ -77,7 +77,7 @@ class OffPolicyLearner : public Learner {
   OffPolicyLearner(std::string algorithm, std::string networks_key, const ObservationSpec& observation,
                    const ActionSpec& action, const Config& c, std::uint64_t seed)
       : spec_(observation), device_(c.device),
-        replay_(observation, nonempty(algorithm, action), c.buffer_size, image_storage_from_string(c.image_storage)), rng_(seed),
+        replay_(observation, nonempty(algorithm, action), c.buffer_size, c.image_storage), rng_(seed),
         schedule_(schedule_of(c)), algorithm_(std::move(algorithm)), key_(std::move(networks_key)) {}
 
   // `action` if it has at least one action (dimension); throws naming the

@@ -6,12 +6,6 @@
 
 namespace comorph::rl {
 
-ImageStorage image_storage_from_string(const std::string& name) {
-  if (name == "uint8") return ImageStorage::kUint8;
-  if (name == "float16") return ImageStorage::kFloat16;
-  throw std::invalid_argument("image_storage must be \"uint8\" or \"float16\", got \"" + name + "\"");
-}
-
 ReplayBuffer::ReplayBuffer(ObservationSpec observation, ActionSpec action, std::int64_t capacity,
                            ImageStorage image_storage)
     : obs_spec_(observation), action_spec_(action), capacity_(capacity), image_storage_(image_storage) {

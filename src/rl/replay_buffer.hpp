@@ -21,12 +21,9 @@
 #include <vector>
 
 #include "rl/env.hpp"
+#include "rl/learner_params.hpp"  // ImageStorage
 
 namespace comorph::rl {
-
-enum class ImageStorage { kUint8, kFloat16 };
-
-ImageStorage image_storage_from_string(const std::string& name);  // "uint8" | "float16"
 
 struct ReplayBatch {
   torch::Tensor image, next_image;           // [B, C, H, W] float32, or undefined

@@ -14,8 +14,8 @@ ActorCritic make_networks(const ObservationSpec& spec, int action_dims, const Td
 }
 
 double noise_std(const Td3Config& c, const LearnerCounters& n) {
-  const double t = c.exploration_noise_unit == "episodes" ? static_cast<double>(n.episodes)
-                                                          : static_cast<double>(n.transitions);
+  const double t = c.exploration_noise_unit == NoiseDecayUnit::episodes ? static_cast<double>(n.episodes)
+                                                                        : static_cast<double>(n.transitions);
   return LinearSchedule{c.exploration_noise_start, c.exploration_noise_end, c.exploration_noise_decay}.at(t);
 }
 

@@ -114,7 +114,7 @@ std::string build_mjcf(const Configuration& config, const RobotParams& p, const 
       "    <light pos=\"2 0 6\" dir=\"0 0 -1\" directional=\"true\"/>\n"
       "    <geom name=\"floor\" type=\"plane\" size=\"20 20 0.1\" pos=\"3 0 0\" material=\"grid\" "
       "friction=\"{6:.6g} 0.005 0.0001\" {7}/>\n",
-      n, s.seed, s.stair_height, s.obstacles.size(), variant_name(s.variant), p.physics_timestep,
+      n, s.seed, s.stair_height, s.obstacles.size(), name_of(s.variant), p.physics_timestep,
       p.friction, kSceneGeom);
   for (std::size_t k = 0; k < s.steps.size(); ++k)
     out += box_geom("step" + std::to_string(k + 1), s.steps[k], "0.6 0.5 0.4 1",

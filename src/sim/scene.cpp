@@ -9,11 +9,11 @@
 namespace comorph::sim {
 
 Variant parse_variant(const std::string& name) {
-  if (name == "standard") return Variant::standard;
-  if (name == "mixed") return Variant::mixed;
-  throw std::invalid_argument("unknown scenario variant '" + name + "' (standard, mixed)");
+  Variant v{};
+  if (!enum_from_name(name, v))
+    throw std::invalid_argument("unknown scenario variant '" + name + "' (" + enum_name_list<Variant>(", ") + ")");
+  return v;
 }
-const char* variant_name(Variant v) { return v == Variant::mixed ? "mixed" : "standard"; }
 
 namespace {
 

@@ -7,13 +7,16 @@
 #include <string>
 #include <vector>
 
+#include "common/enum_names.hpp"
 #include "sim/params.hpp"
 
 namespace comorph::sim {
 
 enum class Variant { standard, mixed };  // mixed: some obstacles on the stair treads
-Variant parse_variant(const std::string& name);  // "standard" | "mixed"; throws otherwise
-const char* variant_name(Variant v);
+constexpr auto enum_names(Variant) {
+  return std::array{EnumName{Variant::standard, "standard"}, EnumName{Variant::mixed, "mixed"}};
+}
+Variant parse_variant(const std::string& name);  // throws std::invalid_argument listing the names
 
 struct Box {          // axis-aligned box
   double x, y, z;     // m, centre

@@ -119,6 +119,25 @@ TEST(Yaml, ABadValueIsQuotedShort) {
   EXPECT_NE(key.find("unknown field"), std::string::npos);
 }
 
+enum class Shade { light, dark };
+constexpr auto enum_names(Shade) { return std::array{EnumName{Shade::light, "light"}, EnumName{Shade::dark, "dark"}}; }
+
+TEST(Yaml, EnumFieldsAreReadAndWrittenByName) {
+  Shade s = Shade::light;
+  YamlFields f("s.yaml");
+  f.add("paint.shade", &s);
+  f.apply_text("paint: {shade: dark}\n");
+  EXPECT_EQ(s, Shade::dark);
+  EXPECT_EQ(name_of(s), "dark");
+  EXPECT_EQ(enum_name_list<Shade>(), "light | dark");
+  EXPECT_EQ(error_of([&] { f.apply_text("paint: {shade: grey}\n"); }),
+            "s.yaml: field 'paint.shade': 'grey' is not one of light | dark");
+  EXPECT_NE(error_of([&] { f.apply_text("paint: {shade: [dark]}\n"); }).find("is not one of"), std::string::npos);
+  const std::string long_name = error_of([&] { f.apply_text("paint: {shade: " + std::string(5000, 'g') + "}\n"); });
+  EXPECT_LT(long_name.size(), 200u) << long_name.substr(0, 300);
+  EXPECT_EQ(s, Shade::dark);  // a refused value leaves the field as it was
+}
+
 TEST(Checksum, FindsAFlippedByteATruncationAndAMissingFile) {
   const std::string dir = test_support::fresh_temp_dir("checksum");
   write_file_atomic(dir + "/a.pt", std::string(10000, 'a'));

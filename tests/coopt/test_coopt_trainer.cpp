@@ -245,7 +245,7 @@ TEST(Trainer, ConfigRefitTrainsAFreshDqnOnTheFrozenMotionModel) {
   CooptConfig plain_config = load_coopt_config(kCi, kWithDemonstrations);
   CooptConfig refit_config = load_coopt_config(kCi, sets);
   EXPECT_NE(greedy_lines(plain_config, plain_dir), greedy_lines(refit_config, refit_dir));
-  plain_config.trainer.mode = refit_config.trainer.mode = "fixed";  // the motion model alone
+  plain_config.trainer.mode = refit_config.trainer.mode = TrainerMode::fixed;  // the motion model alone
   EXPECT_EQ(greedy_lines(plain_config, plain_dir), greedy_lines(refit_config, refit_dir));
 
   const std::string dir = temp_dir("refit_resume");
@@ -474,7 +474,7 @@ TEST(Evaluate, GreedyEpisodesCycleHeightsAndDoNotDependOnWorkers) {
   req.scenario = "obstacles8";
   EXPECT_EQ(evaluate(c, dir, req)[0].obstacles, 8);
   // A forced chain: the motion model drives it, the DQN neither picks nor sheds.
-  ASSERT_EQ(c.trainer.mode, "hierarchical");
+  ASSERT_EQ(c.trainer.mode, TrainerMode::hierarchical);
   req.scenario = "default";
   for (int modules : {3, 7}) {
     req.forced_modules = modules;

@@ -122,16 +122,14 @@ TEST(CooptConfig, UnknownKeysAndOutOfRangeValuesNameTheKey) {
 }
 
 TEST(Scenario, NamesMapToObstaclesAndVariant) {
-  int k = 0;
-  bool mixed = true;
-  scenario_settings("default", k, mixed);
-  EXPECT_EQ(k, -1);
-  EXPECT_FALSE(mixed);
-  scenario_settings("obstacles8", k, mixed);
-  EXPECT_EQ(k, 8);
-  scenario_settings("mixed", k, mixed);
-  EXPECT_TRUE(mixed);
-  EXPECT_THROW(scenario_settings("stairs9", k, mixed), std::runtime_error);
+  EXPECT_EQ(task::scenario_named("default").obstacles, -1);
+  EXPECT_EQ(task::scenario_named("default").variant, sim::Variant::standard);
+  EXPECT_EQ(task::scenario_named("obstacles8").obstacles, 8);
+  EXPECT_EQ(task::scenario_named("mixed").variant, sim::Variant::mixed);
+  EXPECT_THROW(task::scenario_named("stairs9"), std::runtime_error);
+  // The config reads the same names.
+  EXPECT_EQ(load_coopt_config(kCi, {"trainer.scenario=obstacles7"}).trainer.scenario, task::Scenario::obstacles7);
+  expect_error({"trainer.scenario=stairs9"}, "'stairs9' is not one of default | obstacles7 | obstacles8 | mixed");
 }
 
 }  // namespace

@@ -349,7 +349,7 @@ TEST(Dqn, DiscountPerDecisionIgnoresTheSegmentLength) {
   rl::DqnConfig c;
   c.hidden_sizes = {16};
   c.gamma = 0.9;
-  c.discount_per = "decision";
+  c.discount_per = rl::DiscountPer::decision;
   rl::Dqn dqn({0, 0, 0, 2}, 2, c, 3);
   rl::Action a;
   a.discrete = 0;
@@ -391,7 +391,7 @@ TEST(Td3, ExplorationNoiseDecaysPerEpisode) {
   c.exploration_noise_start = 0.12;
   c.exploration_noise_end = 0.02;
   c.exploration_noise_decay = 4;
-  c.exploration_noise_unit = "episodes";
+  c.exploration_noise_unit = rl::NoiseDecayUnit::episodes;
   rl::Td3 td3({0, 0, 0, 1}, 1, c, 1);
   rl::Action a;
   a.continuous = {0};
@@ -545,8 +545,8 @@ TEST(Config, EveryPresetLoadsAndUnknownFieldsAreRejected) {
     EXPECT_NE(std::string(e.what()).find("gama"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("my.yaml"), std::string::npos);
   }
-  EXPECT_THROW(rl::DqnConfig::from_yaml(YAML::Load("loss: l1"), "x"), std::invalid_argument);
-  EXPECT_THROW(rl::DqnConfig::from_yaml(YAML::Load("discount_per: episode"), "x"), std::invalid_argument);
+  EXPECT_THROW(rl::DqnConfig::from_yaml(YAML::Load("loss: l1"), "x"), std::runtime_error);
+  EXPECT_THROW(rl::DqnConfig::from_yaml(YAML::Load("discount_per: episode"), "x"), std::runtime_error);
   EXPECT_THROW(rl::SacConfig::from_yaml(YAML::Load("batch_size: abc"), "x"), std::runtime_error);
   EXPECT_THROW(rl::make_learner("dqn", {0, 0, 0, 3}, {rl::ActionKind::kContinuous, 1}, YAML::Node(),
                                 "x", 1),
