@@ -5,6 +5,7 @@
 // algorithm adds act(), update(), its networks and its part of a checkpoint.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -28,6 +29,25 @@ torch::Tensor gaussian_noise(std::int64_t rows, std::int64_t cols, double std, s
 // caller explores, fills `action` uniformly in [-1, 1] and returns true.
 bool random_warmup_action(std::int64_t random_action_steps, std::int64_t random_action_episodes,
                           const LearnerCounters& counters, bool explore, std::mt19937_64& rng, Action& action);
+
+// The acting rule TD3 and SAC share, for the learner and its Policy: a uniform
+// action during the random-action warm-up (returns false), else the 1 x
+// action_dims tensor `actor_output()` (run under InferenceMode) copied into
+// action.continuous (returns true).
+template <typename Config, typename ActorOutput>
+bool act_continuous(const Config& c, int action_dims, const LearnerCounters& counters, bool explore,
+                    std::mt19937_64& rng, Action& action, ActorOutput&& actor_output) {
+  action.continuous.resize(action_dims);
+  if (random_warmup_action(c.random_action_steps, c.random_action_episodes, counters, explore, rng, action))
+    return false;
+  torch::Tensor a;
+  {
+    torch::InferenceMode guard;
+    a = actor_output().to(torch::kCPU);
+  }
+  std::copy(a.data_ptr<float>(), a.data_ptr<float>() + action_dims, action.continuous.begin());
+  return true;
+}
 
 // One gradient step: zero_grad, backward, the gradient's L2 norm clipped to
 // max_grad_norm (0: not clipped), step; over the optimizer's own parameters.

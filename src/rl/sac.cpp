@@ -36,20 +36,11 @@ std::pair<torch::Tensor, torch::Tensor> sample_action(ActorCritic& nets, const S
 void act_with(ActorCritic& nets, const ObservationSpec& spec, int action_dims, const SacConfig& c,
               const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng, const Observation& o,
               bool explore, Action& action) {
-  action.continuous.resize(action_dims);
-  if (random_warmup_action(c.random_action_steps, c.random_action_episodes, n, explore, rng, action)) return;
-  torch::Tensor a;
-  {
-    torch::InferenceMode guard;
+  act_continuous(c, action_dims, n, explore, rng, action, [&] {
     const torch::Tensor f = actor_features_of(nets, o, spec, device);
-    if (explore) {
-      a = sample_action(nets, c, action_dims, f, rng, device).first;
-    } else {
-      a = torch::tanh(nets->actor_head(f).slice(1, 0, action_dims));  // the mean action
-    }
-    a = a.to(torch::kCPU);
-  }
-  std::copy(a.data_ptr<float>(), a.data_ptr<float>() + action_dims, action.continuous.begin());
+    if (explore) return sample_action(nets, c, action_dims, f, rng, device).first;
+    return torch::tanh(nets->actor_head(f).slice(1, 0, action_dims));  // the mean action
+  });
 }
 
 }  // namespace

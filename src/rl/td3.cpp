@@ -24,20 +24,12 @@ double noise_std(const Td3Config& c, const LearnerCounters& n) {
 void act_with(ActorCritic& nets, const ObservationSpec& spec, int action_dims, const Td3Config& c,
               const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng, const Observation& o,
               bool explore, Action& action) {
-  action.continuous.resize(action_dims);
-  if (random_warmup_action(c.random_action_steps, c.random_action_episodes, n, explore, rng, action)) return;
-  torch::Tensor a;
-  {
-    torch::InferenceMode guard;
-    a = torch::tanh(nets->actor_head(actor_features_of(nets, o, spec, device))).to(torch::kCPU);
-  }
-  const float* p = a.data_ptr<float>();
+  const bool from_actor = act_continuous(c, action_dims, n, explore, rng, action, [&] {
+    return torch::tanh(nets->actor_head(actor_features_of(nets, o, spec, device)));
+  });
+  if (!from_actor || !explore) return;
   std::normal_distribution<float> normal(0.0f, static_cast<float>(noise_std(c, n)));
-  for (int i = 0; i < action_dims; ++i) {
-    float v = p[i];
-    if (explore) v = std::clamp(v + normal(rng), -1.0f, 1.0f);
-    action.continuous[i] = v;
-  }
+  for (float& v : action.continuous) v = std::clamp(v + normal(rng), -1.0f, 1.0f);
 }
 
 }  // namespace
