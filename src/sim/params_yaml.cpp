@@ -1,10 +1,25 @@
 // YAML loaders of RobotParams and SceneParams (ranges are physical sanity bounds).
+#include <array>
 #include <cmath>
 
 #include "sim/params.hpp"
 #include "common/yaml_fields.hpp"
 
 namespace comorph::sim {
+namespace {
+
+// A depth camera's fields (the module's camera and the decision camera) and
+// their ranges, declared once: image size (pixels), field of view (rad), pitch (rad).
+void add_camera(YamlFields& f, const std::array<const char*, 5>& names, int& width, int& height, double& fov_y,
+                double& fov_x, double& pitch) {
+  f.add(names[0], &width, 1, 256);
+  f.add(names[1], &height, 1, 256);
+  f.add(names[2], &fov_y, 0.05, 3.0);
+  f.add(names[3], &fov_x, 0.05, 3.0);
+  f.add(names[4], &pitch, -1.5, 1.5);
+}
+
+}  // namespace
 
 RobotParams robot_params_from_yaml(const std::string& text, const std::string& source,
                                    RobotParams p) {
@@ -32,17 +47,11 @@ RobotParams robot_params_from_yaml(const std::string& text, const std::string& s
   f.add("hinge_armature", &p.hinge_armature, 0, 1);
   f.add("hinge_damping", &p.hinge_damping, 0, 100);
   f.add("friction", &p.friction, 0.05, 3);
-  f.add("depth_width", &p.depth_width, 1, 256);
-  f.add("depth_height", &p.depth_height, 1, 256);
-  f.add("depth_fov_y", &p.depth_fov_y, 0.05, 3.0);
-  f.add("depth_fov_x", &p.depth_fov_x, 0.05, 3.0);
-  f.add("depth_pitch", &p.depth_pitch, -1.5, 1.5);
+  add_camera(f, {"depth_width", "depth_height", "depth_fov_y", "depth_fov_x", "depth_pitch"}, p.depth_width,
+             p.depth_height, p.depth_fov_y, p.depth_fov_x, p.depth_pitch);
   f.add("depth_max_range", &p.depth_max_range, 0.1, 100);
-  f.add("decision_depth_width", &p.decision_depth_width, 1, 256);
-  f.add("decision_depth_height", &p.decision_depth_height, 1, 256);
-  f.add("decision_fov_y", &p.decision_fov_y, 0.05, 3.0);
-  f.add("decision_fov_x", &p.decision_fov_x, 0.05, 3.0);
-  f.add("decision_pitch", &p.decision_pitch, -1.5, 1.5);
+  add_camera(f, {"decision_depth_width", "decision_depth_height", "decision_fov_y", "decision_fov_x", "decision_pitch"},
+             p.decision_depth_width, p.decision_depth_height, p.decision_fov_y, p.decision_fov_x, p.decision_pitch);
   f.add("scan_columns", &p.scan_columns, 0, 256);
   f.add("scan_fov_x", &p.scan_fov_x, 0.05, 6.28);
   f.add("camera_height", &p.camera_height, 0.0, 1.0);
