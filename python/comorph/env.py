@@ -47,9 +47,9 @@ except ImportError:  # the same surface without Gymnasium
 
 ENV_ID = "comorph/MultiTask-v0"
 TERMINATIONS = tuple(_core.termination_names())  # info["termination"] values; VectorEnv's info["reason"] indexes it
-# The scenarios of `comorph eval --scenario` (task::kScenarios; a test checks
-# they agree): name -> (obstacles K or None for the scene's default, mixed variant).
-SCENARIOS = {"default": (None, False), "obstacles7": (7, False), "obstacles8": (8, False), "mixed": (None, True)}
+# The scenarios of `comorph eval --scenario`, from the C++ registry (task::kScenarios):
+# name -> (obstacles K or None for the scene's default, mixed variant).
+SCENARIOS = dict(_core.scenarios())
 _OPTIONS = ("modules", "stair_height")
 
 

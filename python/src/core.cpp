@@ -27,6 +27,7 @@
 #include "common/resources.hpp"
 #include "env_core.hpp"
 #include "morphology/configuration.hpp"
+#include "task/scenario.hpp"
 #include "report/offscreen_renderer.hpp"
 
 namespace py = pybind11;
@@ -587,6 +588,14 @@ PYBIND11_MODULE(_core, m) {
   m.def("resource_dir", [] { return resource_dir(); },
         "the directory of comorph's data files (configs/): $COMORPH_RESOURCES, else the first parent of this "
         "module that holds them");
+  m.def("scenarios", [] {
+    // name -> (obstacles K or None for the scene's default, mixed variant): task::kScenarios.
+    py::dict out;
+    for (const task::ScenarioSpec& s : task::kScenarios)
+      out[py::str(s.name)] = py::make_tuple(s.obstacles < 0 ? py::object(py::none()) : py::int_(s.obstacles),
+                                            s.variant == sim::Variant::mixed);
+    return out;
+  });
   m.def("termination_names", [] {
     std::vector<std::string> names;
     for (int t = 0; t <= static_cast<int>(task::Termination::step_cap); ++t)

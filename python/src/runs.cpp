@@ -115,8 +115,4 @@ PYBIND11_MODULE(_runs, m) {
       .def_property_readonly("eval_episodes", [](const Run& r) { return r.config().eval.episodes; });
   m.def("evaluate", &evaluate, py::arg("path"), py::arg("episodes"), py::arg("seed"), py::arg("scenario"),
         py::arg("workers"));
-  m.def("scenario_settings", [](const std::string& name) {
-    const task::ScenarioSpec& s = task::scenario_named(name);
-    return py::make_tuple(s.obstacles, s.variant == sim::Variant::mixed);
-  });
 }

@@ -30,9 +30,9 @@ def test_evaluate_equals_comorph_eval(work, monkeypatch):
 
 
 def test_scenarios_agree_with_the_cli_and_bad_ones_are_refused(work, monkeypatch):
-    from comorph import _runs
-    for name, (obstacles, mixed) in comorph.SCENARIOS.items():
-        assert _runs.scenario_settings(name) == (-1 if obstacles is None else obstacles, mixed)
+    # The C++ registry's rows, as `comorph eval --scenario` knows them.
+    assert comorph.SCENARIOS == {"default": (None, False), "obstacles7": (7, False), "obstacles8": (8, False),
+                                 "mixed": (None, True)}
     monkeypatch.chdir(work)
     with pytest.raises(RuntimeError, match="unknown scenario 'stairs'"):
         comorph.evaluate(RUN, episodes=1, seed=1, scenario="stairs")
