@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 
@@ -58,6 +59,25 @@ TEST(Experiment, Table2TrainsEveryColumnWritesTheTableAndResumesWithoutRetrainin
   EXPECT_NE(run_cli(command + " --set trainer.episodes=5", log), 0);
   EXPECT_NE(log.find("another configuration"), std::string::npos) << log;
   EXPECT_NE(log.find("hier-td3"), std::string::npos) << log;
+  fs::remove_all(out);
+}
+
+// A preset with a DQN refit (configs/standard.yaml) still has fixed columns: a
+// fixed chain has no DQN, so its motion model trains for the hierarchy's
+// warm-up and training episodes and nothing is refitted.
+TEST(Experiment, FixedColumnOfAPresetWithADqnRefitTrainsTheMotionBudgetOnly) {
+  const fs::path out = fs::temp_directory_path() / ("comorph_experiment_refit_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  std::string log;
+  ASSERT_EQ(run_cli("experiment --table 1 --only fixed-2 --config " + kCi +
+                        " --set trainer.config_refit_episodes=3 --eval-episodes 3 --out " + out.string(),
+                    log),
+            0)
+      << log;
+  const std::string episodes = read_text(out / "fixed-2/episodes.csv");
+  EXPECT_EQ(std::count(episodes.begin(), episodes.end(), '\n'), 1 + 2 + 4);  // header, ci.yaml's 2 + 4 episodes
+  EXPECT_NE(read_text(out / "fixed-2/config.yaml").find("config_refit_episodes: 0"), std::string::npos);
+  EXPECT_TRUE(fs::exists(out / "fixed-2/eval-default.json"));
   fs::remove_all(out);
 }
 
