@@ -42,111 +42,8 @@ extern "C" void on_signal(int) { g_stop = true; }
 // The report's columns of a log (the base part: EpisodeLog extends the record).
 const comorph::report::EpisodeRecord& to_record(const EpisodeLog& l) { return l; }
 
-// One CSV row in report's format (the writer's output without its header).
-void append_episode(const std::string& path, const EpisodeLog& log) {
-  std::ostringstream s;
-  comorph::report::write_episodes_csv(s, {to_record(log)});
-  const std::string text = s.str();
-  append_file(path, text.substr(text.find('\n') + 1));
-}
-
 // F(H) as the env defines it (task/rewards.hpp, env.task.objective in the config).
 const comorph::task::ObjectiveWeights& f_weights(const CooptConfig& c) { return c.env.task.objective; }
-
-// Largest episodes.csv / evaluations.csv resume reads (4300 episodes take ~0.5 MB).
-constexpr std::size_t kMaxRunCsvBytes = 256u << 20;
-
-const char* kEvalColumns =
-    "train_episode,env_steps,wall_s,episodes,success_0.04,success_0.06,success_0.08,success_avg,"
-    "mean_return_R1,mean_distance_fraction,mean_F,configurations\n";
-
-void append_evaluation(const std::string& path, const CooptConfig& c, const comorph::coopt::EvaluationLog& e) {
-  std::vector<comorph::report::EpisodeRecord> records;
-  double ret = 0, dist = 0;
-  for (const auto& l : e.episodes) {
-    records.push_back(to_record(l));
-    ret += l.return_R1;
-    dist += l.distance_fraction;
-  }
-  const auto m = comorph::report::summarize(records, f_weights(c));
-  const double n = static_cast<double>(e.episodes.size());
-  std::string configs;  // "0.04:4x2|6->2x1 0.06:..."
-  for (const auto& [height, seqs] : m.configurations) {
-    configs += (configs.empty() ? "" : " ") + height + ":";
-    bool first = true;
-    for (const auto& [seq, count] : seqs) {
-      configs += (first ? "" : "|") + seq + "x" + std::to_string(count);
-      first = false;
-    }
-  }
-  std::ostringstream out;
-  out << e.train_episode << ',' << e.env_steps << ',' << fmt::format("{:.1f}", e.wall_s) << ',' << e.episodes.size()
-      << ',' << format_rate(m.success_rate.at("0.04")) << ',' << format_rate(m.success_rate.at("0.06")) << ','
-      << format_rate(m.success_rate.at("0.08")) << ',' << format_rate(m.success_rate.at("avg")) << ','
-      << fmt::format("{:.2f}", ret / n) << ',' << fmt::format("{:.3f}", dist / n) << ','
-      << fmt::format("{:.3f}", m.F) << ',' << configs << '\n';
-  append_file(path, out.str());
-  std::fprintf(stderr,
-               "evaluation after %d episodes: success 0.04/0.06/0.08 m = %s/%s/%s (avg %s), return %.1f, "
-               "distance %.0f %%, configurations %s\n",
-               e.train_episode, format_rate(m.success_rate.at("0.04")).c_str(), format_rate(m.success_rate.at("0.06")).c_str(),
-               format_rate(m.success_rate.at("0.08")).c_str(), format_rate(m.success_rate.at("avg")).c_str(), ret / n,
-               100.0 * dist / n, configs.c_str());
-}
-
-// Data lines of a CSV file after its header (a missing file has none).
-std::vector<std::string> csv_data_lines(const std::string& path, std::string& header) {
-  std::vector<std::string> lines;
-  if (!fs::exists(path)) return lines;
-  std::istringstream in(read_text_file(path, kMaxRunCsvBytes));
-  std::getline(in, header);
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  return lines;
-}
-
-// Resume continues episodes.csv and evaluations.csv after the rows the
-// checkpoint counts (later rows come from after it and are dropped). Those
-// rows must all be there and be rows of these files: a shorter file would
-// leave a permanent gap, a garbled one would be kept and appended to.
-void check_rows_for_resume(const std::string& episodes_csv, const std::string& evaluations_csv,
-                           const comorph::coopt::CheckpointInfo& checkpoint) {
-  std::string header;
-  const auto episodes = csv_data_lines(episodes_csv, header);
-  if (static_cast<int>(episodes.size()) < checkpoint.episodes)
-    throw std::runtime_error(fmt::format(
-        "{}: {} rows, but the checkpoint ({}) counts {} episodes; refusing to resume with a gap", episodes_csv,
-        episodes.size(), checkpoint.directory, checkpoint.episodes));
-  std::string kept = header + "\n";
-  for (int i = 0; i < checkpoint.episodes; ++i) kept += episodes[static_cast<std::size_t>(i)] + "\n";
-  std::istringstream rows(kept);
-  std::vector<comorph::report::EpisodeRecord> records;
-  try {
-    records = comorph::report::read_episodes_csv(rows, episodes_csv);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(std::string(e.what()) + "; refusing to resume from a damaged episodes.csv");
-  }
-  for (int i = 0; i < checkpoint.episodes; ++i)
-    if (records[static_cast<std::size_t>(i)].episode != i)
-      throw std::runtime_error(fmt::format("{}:{}: episode {} where episode {} belongs; refusing to resume",
-                                           episodes_csv, i + 2, records[static_cast<std::size_t>(i)].episode, i));
-
-  const auto evaluations = csv_data_lines(evaluations_csv, header);
-  const std::string columns = std::string(kEvalColumns).substr(0, std::string(kEvalColumns).size() - 1);
-  if (checkpoint.evaluations > 0 && header != columns)
-    throw std::runtime_error(evaluations_csv + ":1: not the header of evaluations.csv; refusing to resume");
-  if (static_cast<int>(evaluations.size()) < checkpoint.evaluations)
-    throw std::runtime_error(fmt::format(
-        "{}: {} rows, but the checkpoint ({}) counts {} evaluations; refusing to resume with a gap",
-        evaluations_csv, evaluations.size(), checkpoint.directory, checkpoint.evaluations));
-  const auto fields = std::count(columns.begin(), columns.end(), ',') + 1;
-  for (int i = 0; i < checkpoint.evaluations; ++i) {
-    const std::string& row = evaluations[static_cast<std::size_t>(i)];
-    if (std::count(row.begin(), row.end(), ',') + 1 != fields || row.empty() ||
-        row.find_first_not_of("0123456789") != row.find(','))
-      throw std::runtime_error(fmt::format("{}:{}: not a row of evaluations.csv ('{}'); refusing to resume",
-                                           evaluations_csv, i + 2, quote_value(row)));
-  }
-}
 
 }  // namespace
 
@@ -168,7 +65,6 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
   std::string run_dir;
   CooptConfig config;
   std::unique_ptr<RunLock> lock;  // one writer per run directory, for the whole training
-  comorph::coopt::CheckpointInfo checkpoint;
   if (!resume.empty()) {
     if (!config_path.empty() || !sets.empty())
       throw std::runtime_error("--resume takes the run's own config.yaml; drop --config/--set");
@@ -179,7 +75,7 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
     const std::string path = (fs::path(run_dir) / "config.yaml").string();
     if (!fs::exists(path)) throw std::runtime_error(run_dir + ": not a training run (no config.yaml)");
     config = comorph::coopt::load_coopt_config(path);
-    checkpoint = comorph::coopt::read_checkpoint_info(run_dir);  // throws when there is no checkpoint
+    comorph::coopt::read_checkpoint_info(run_dir);  // throws when there is no checkpoint
   } else {
     if (config_path.empty()) throw std::runtime_error("train: give --config FILE (or --resume runs/NAME)");
     if (out.empty()) throw std::runtime_error("train: give --out runs/NAME");
@@ -188,15 +84,8 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
       throw std::runtime_error(out + " exists and is not empty (use --resume " + out + " to continue it)");
     run_dir = out;
   }
-  const std::string episodes_csv = (fs::path(run_dir) / "episodes.csv").string();
-  const std::string evaluations_csv = (fs::path(run_dir) / "evaluations.csv").string();
-  comorph::coopt::TrainerCallbacks callbacks;
-  callbacks.on_episode = [&](const EpisodeLog& l) { append_episode(episodes_csv, l); };
-  callbacks.on_evaluation = [&](const comorph::coopt::EvaluationLog& e) {
-    append_evaluation(evaluations_csv, config, e);
-  };
   // Everything that can fail on bad input happens before the directory exists.
-  comorph::coopt::Trainer trainer(config, run_dir, callbacks);
+  comorph::coopt::Trainer trainer(config, run_dir);
 
   if (resume.empty()) {
     fs::create_directories(run_dir);
@@ -205,22 +94,8 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
     // above too; the one that locked first owns it.
     if (!is_empty_run_dir(run_dir))
       throw std::runtime_error(run_dir + " was filled by another process meanwhile; refusing to write into it");
-    write_file_atomic((fs::path(run_dir) / "config.yaml").string(), config.text + "\n");
-    comorph::report::RunInfo info;
-    info.name = fs::path(run_dir).filename().string();
-    info.kind = comorph::name_of(config.trainer.mode);
-    info.modules =
-        config.trainer.mode == comorph::coopt::TrainerMode::fixed ? config.trainer.fixed_modules : comorph::kMaxModules;
-    info.algo = config.trainer.motion_algo;
-    info.scenario = comorph::name_of(config.trainer.scenario);
-    info.episodes = config.trainer.total_episodes();
-    info.preset = config.preset;
-    info.notes = "scene source: " + comorph::name_of(config.trainer.scene_source);
-    comorph::report::write_run_info((fs::path(run_dir) / "run.yaml").string(), info);
-    comorph::report::write_episodes_csv(episodes_csv, {});
-    write_file_atomic(evaluations_csv, kEvalColumns);
+    // trainer.run() writes config.yaml, run.yaml and the CSV headers.
   } else {
-    check_rows_for_resume(episodes_csv, evaluations_csv, checkpoint);
     trainer.resume();
     std::fprintf(stderr, "resuming %s after %d episodes (%lld control steps)\n", run_dir.c_str(),
                  trainer.episodes_done(), static_cast<long long>(trainer.env_steps()));

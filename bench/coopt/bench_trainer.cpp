@@ -21,15 +21,12 @@
 #include <atomic>
 #include <cstdlib>
 #include <filesystem>
-#include <sstream>
 #include <string>
 #include <vector>
 
-#include "common/file_io.hpp"
 #include "common/resources.hpp"
 #include "coopt/config.hpp"
 #include "coopt/trainer.hpp"
-#include "report/episode_record.hpp"
 
 namespace fs = std::filesystem;
 using namespace comorph;
@@ -88,16 +85,11 @@ int main(int argc, char** argv) {
     fs::create_directories(run_dir);
 
     // 1. The trainer, stopped after the episode that reaches --steps.
-    const std::string episodes_csv = (fs::path(run_dir) / "episodes.csv").string();
-    report::write_episodes_csv(episodes_csv, {});
     std::atomic<bool> stop{false};
     std::int64_t done = 0;
     int episodes = 0;
     coopt::TrainerCallbacks callbacks;
     callbacks.on_episode = [&](const coopt::EpisodeLog& l) {
-      std::ostringstream row;  // one row in report's format, as `comorph train` appends it
-      report::write_episodes_csv(row, {static_cast<const task::EpisodeRecord&>(l)});
-      append_file(episodes_csv, row.str().substr(row.str().find('\n') + 1));
       done += l.steps;
       ++episodes;
       if (done >= steps) stop = true;

@@ -6,11 +6,18 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <cmath>
 #include <map>
 #include <sstream>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "common/checksum.hpp"
 #include "common/file_io.hpp"
+#include "report/episode_record.hpp"
+#include "report/metrics.hpp"
+#include "report/run_dir.hpp"
 #include "rl/learner.hpp"
 #include "rl/policy.hpp"
 #include "rl/replay_buffer.hpp"
@@ -57,6 +64,70 @@ std::string first_difference(const std::string& a, const std::string& b) {
     if (!ga || !gb || la != lb)
       return "line " + std::to_string(line) + ": checkpoint has '" + quote_value(gb ? lb : "<end>") +
              "', config has '" + quote_value(ga ? la : "<end>") + "'";
+  }
+}
+
+// Largest episodes.csv / evaluations.csv a resume reads (4300 episodes take ~0.5 MB).
+constexpr std::size_t kMaxRunCsvBytes = 256u << 20;
+
+constexpr const char* kEvalColumns =
+    "train_episode,env_steps,wall_s,episodes,success_0.04,success_0.06,success_0.08,success_avg,"
+    "mean_return_R1,mean_distance_fraction,mean_F,configurations";
+
+// "0.53", or "-" for NaN (no episode of that kind).
+std::string format_rate(double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.2f}", v); }
+
+// Data lines of a CSV file after its header (a missing file has none).
+std::vector<std::string> csv_data_lines(const std::string& path, std::string& header) {
+  std::vector<std::string> lines;
+  if (!fs::exists(path)) return lines;
+  std::istringstream in(read_text_file(path, kMaxRunCsvBytes));
+  std::getline(in, header);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// Resume continues episodes.csv and evaluations.csv after the rows the
+// checkpoint counts (later rows come from after it and are dropped). Those
+// rows must all be there and be rows of these files: a shorter file would
+// leave a permanent gap, a garbled one would be kept and appended to.
+void check_rows_for_resume(const std::string& episodes_csv, const std::string& evaluations_csv,
+                           const CheckpointInfo& checkpoint) {
+  std::string header;
+  const auto episodes = csv_data_lines(episodes_csv, header);
+  if (static_cast<int>(episodes.size()) < checkpoint.episodes)
+    throw std::runtime_error(fmt::format(
+        "{}: {} rows, but the checkpoint ({}) counts {} episodes; refusing to resume with a gap", episodes_csv,
+        episodes.size(), checkpoint.directory, checkpoint.episodes));
+  std::string kept = header + "\n";
+  for (int i = 0; i < checkpoint.episodes; ++i) kept += episodes[static_cast<std::size_t>(i)] + "\n";
+  std::istringstream rows(kept);
+  std::vector<report::EpisodeRecord> records;
+  try {
+    records = report::read_episodes_csv(rows, episodes_csv);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(std::string(e.what()) + "; refusing to resume from a damaged episodes.csv");
+  }
+  for (int i = 0; i < checkpoint.episodes; ++i)
+    if (records[static_cast<std::size_t>(i)].episode != i)
+      throw std::runtime_error(fmt::format("{}:{}: episode {} where episode {} belongs; refusing to resume",
+                                           episodes_csv, i + 2, records[static_cast<std::size_t>(i)].episode, i));
+
+  const auto evaluations = csv_data_lines(evaluations_csv, header);
+  const std::string columns = kEvalColumns;
+  if (checkpoint.evaluations > 0 && header != columns)
+    throw std::runtime_error(evaluations_csv + ":1: not the header of evaluations.csv; refusing to resume");
+  if (static_cast<int>(evaluations.size()) < checkpoint.evaluations)
+    throw std::runtime_error(fmt::format(
+        "{}: {} rows, but the checkpoint ({}) counts {} evaluations; refusing to resume with a gap",
+        evaluations_csv, evaluations.size(), checkpoint.directory, checkpoint.evaluations));
+  const auto fields = std::count(columns.begin(), columns.end(), ',') + 1;
+  for (int i = 0; i < checkpoint.evaluations; ++i) {
+    const std::string& row = evaluations[static_cast<std::size_t>(i)];
+    if (std::count(row.begin(), row.end(), ',') + 1 != fields || row.empty() ||
+        row.find_first_not_of("0123456789") != row.find(','))
+      throw std::runtime_error(fmt::format("{}:{}: not a row of evaluations.csv ('{}'); refusing to resume",
+                                           evaluations_csv, i + 2, quote_value(row)));
   }
 }
 
@@ -156,6 +227,63 @@ void truncate_csv_rows(const std::string& path, int rows) {
 
 std::string RunStore::path(const std::string& name) const { return (fs::path(dir_) / name).string(); }
 
+void RunStore::create(const CooptConfig& config) const {
+  // A Trainer run() without resume() on a finished or interrupted run would
+  // otherwise start its CSV files and checkpoint over.
+  if (fs::exists(path("config.yaml")))
+    throw std::runtime_error(dir_ + ": already holds a run (config.yaml); resume it instead of starting it again");
+  write_file_atomic(path("config.yaml"), config.text + "\n");
+  report::RunInfo info;
+  info.name = fs::path(dir_).filename().string();
+  info.kind = name_of(config.trainer.mode);
+  info.modules = config.trainer.mode == TrainerMode::fixed ? config.trainer.fixed_modules : kMaxModules;
+  info.algo = config.trainer.motion_algo;
+  info.scenario = name_of(config.trainer.scenario);
+  info.episodes = config.trainer.total_episodes();
+  info.preset = config.preset;
+  info.notes = "scene source: " + name_of(config.trainer.scene_source);
+  report::write_run_info(path("run.yaml"), info);
+  report::write_episodes_csv(path("episodes.csv"), {});
+  write_file_atomic(path("evaluations.csv"), std::string(kEvalColumns) + "\n");
+}
+
+void RunStore::append_episode(const EpisodeLog& log) const {
+  std::ostringstream s;
+  report::write_episodes_csv(s, {static_cast<const report::EpisodeRecord&>(log)});
+  const std::string text = s.str();
+  append_file(path("episodes.csv"), text.substr(text.find('\n') + 1));  // the row without the header
+}
+
+std::string RunStore::append_evaluation(const CooptConfig& config, const EvaluationLog& e) const {
+  std::vector<report::EpisodeRecord> records;
+  double ret = 0, dist = 0;
+  for (const auto& l : e.episodes) {
+    records.push_back(l);
+    ret += l.return_R1;
+    dist += l.distance_fraction;
+  }
+  const auto m = report::summarize(records, config.env.task.objective);
+  const double n = static_cast<double>(e.episodes.size());
+  std::string configs;  // "0.04:4x2|6->2x1 0.06:..."
+  for (const auto& [height, seqs] : m.configurations) {
+    configs += (configs.empty() ? "" : " ") + height + ":";
+    bool first = true;
+    for (const auto& [seq, count] : seqs) {
+      configs += (first ? "" : "|") + seq + "x" + std::to_string(count);
+      first = false;
+    }
+  }
+  const auto rate = [&](const char* key) { return format_rate(m.success_rate.at(key)); };
+  append_file(path("evaluations.csv"),
+              fmt::format("{},{},{:.1f},{},{},{},{},{},{:.2f},{:.3f},{:.3f},{}\n", e.train_episode, e.env_steps,
+                          e.wall_s, e.episodes.size(), rate("0.04"), rate("0.06"), rate("0.08"), rate("avg"),
+                          ret / n, dist / n, m.F, configs));
+  return fmt::format(
+      "evaluation after {} episodes: success 0.04/0.06/0.08 m = {}/{}/{} (avg {}), return {:.1f}, distance {:.0f} %, "
+      "configurations {}",
+      e.train_episode, rate("0.04"), rate("0.06"), rate("0.08"), rate("avg"), ret / n, 100.0 * dist / n, configs);
+}
+
 void RunStore::save_checkpoint(TrainingState& s, const CooptConfig& config, double wall_s) const {
   const std::string dir = checkpoint_dir_of(dir_);
   const std::string tmp = dir + ".tmp", old = dir + ".old";
@@ -234,6 +362,7 @@ void RunStore::load_checkpoint(TrainingState& s, const CooptConfig& config) cons
   } catch (const std::exception& e) {
     throw std::runtime_error(std::string(e.what()) + "; refusing to resume");
   }
+  check_rows_for_resume(path("episodes.csv"), path("evaluations.csv"), info);
   load_learner_file(*s.motion, (fs::path(info.directory) / "motion.pt").string());
   if (!s.motion_on_policy) s.motion_segments = load_replay(*s.motion, "motion", info.directory);
   load_learner_file(*s.agent.motion, (fs::path(info.directory) / "motion_actor.pt").string());

@@ -270,6 +270,10 @@ bool Trainer::run(const std::atomic<bool>* stop) {
     m.laps.lap(kCheckpoint);
     ++m.run_checkpoints;
   };
+  if (!m.run_files) {
+    m.store.create(m.config);
+    m.run_files = true;
+  }
   while (m.state.episode < total) {
     if (stop && stop->load()) {
       checkpoint();
@@ -278,6 +282,7 @@ bool Trainer::run(const std::atomic<bool>* stop) {
     const EpisodeLog log = m.train_episode();
     ++m.state.episode;
     m.laps.lap(kOther);
+    m.store.append_episode(log);
     if (m.callbacks.on_episode) m.callbacks.on_episode(log);
     m.progress(log);
     m.laps.lap(kLogging);
@@ -286,6 +291,7 @@ bool Trainer::run(const std::atomic<bool>* stop) {
       const EvaluationLog e = m.periodic_evaluation();
       ++m.state.evaluations;
       m.laps.lap(kEvaluation);
+      std::fprintf(stderr, "%s\n", m.store.append_evaluation(m.config, e).c_str());
       if (m.callbacks.on_evaluation) m.callbacks.on_evaluation(e);
       m.laps.lap(kLogging);
     }

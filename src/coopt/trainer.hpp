@@ -140,7 +140,8 @@ struct TrainerTiming {
 
 class Trainer {
  public:
-  // run_dir must exist; checkpoints go to run_dir/checkpoint, evaluations.csv is written there.
+  // run_dir must exist. The trainer is its only writer (coopt/run_store.hpp):
+  // config.yaml, run.yaml, episodes.csv, evaluations.csv and checkpoint/.
   Trainer(const CooptConfig& config, const std::string& run_dir, TrainerCallbacks callbacks = {});
   ~Trainer();
   // Loads run_dir's latest checkpoint; throws (naming the difference) when it
@@ -148,7 +149,9 @@ class Trainer {
   // evaluations.csv to the rows the checkpoint counted.
   void resume();
   // Trains until every episode is done (returns true) or *stop becomes true
-  // (the current episode is finished and checkpointed; returns false).
+  // (the current episode is finished and checkpointed; returns false). A run
+  // not resumed starts by writing config.yaml, run.yaml and the CSV headers
+  // (throws when run_dir already holds a run: resume() it instead).
   bool run(const std::atomic<bool>* stop = nullptr);
 
   int episodes_done() const;

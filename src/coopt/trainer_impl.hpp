@@ -38,6 +38,7 @@ struct Trainer::Impl {
   std::unique_ptr<LearnerWorker> worker;
 
   Clock::time_point started = Clock::now();
+  bool run_files = false;  // config.yaml, run.yaml and the CSV files exist (written by run(), or resumed)
   std::vector<double> recent_success;  // last 20 training episodes
 
   // TrainerTiming: the acting thread's laps, run()'s wall time and checkpoints,
@@ -70,6 +71,7 @@ struct Trainer::Impl {
   void load_checkpoint() {
     store.load_checkpoint(state, config);
     started = Clock::now();
+    run_files = true;
   }
 };
 

@@ -175,11 +175,19 @@ TEST(Checkpoint, AChangedSimulatorConfigIsRefusedOnResume) {
 // A checkpoint write that fails (here a file-size limit, as a full disk would)
 // names the file and the reason; the last good checkpoint stays and resumes.
 TEST(Checkpoint, AFailedWriteKeepsTheLastGoodCheckpoint) {
-  const std::string dir = trained_run("full");
+  const std::string dir = test_support::fresh_temp_dir("reliability_full");
   const CooptConfig c = load_coopt_config(kCi, kRunSets);
-  // A trainer on the run's directory asked to stop before its first episode:
-  // run() writes a checkpoint at once, and that write fails.
+  {  // Ctrl-C after its second episode: checkpointed there.
+    std::atomic<bool> stop{false};
+    TrainerCallbacks cb;
+    cb.on_episode = [&stop](const EpisodeLog& l) { stop = l.episode == 1; };
+    Trainer first(c, dir, cb);
+    EXPECT_FALSE(first.run(&stop));
+  }
+  // Resumed and asked to stop before its next episode: run() writes a
+  // checkpoint at once, and that write fails.
   Trainer t(c, dir);
+  t.resume();
   std::atomic<bool> stop{true};
   std::signal(SIGXFSZ, SIG_IGN);
   rlimit saved{};
@@ -195,7 +203,19 @@ TEST(Checkpoint, AFailedWriteKeepsTheLastGoodCheckpoint) {
   EXPECT_EQ(verify_checksums(dir + "/checkpoint"), "");
   Trainer again(c, dir);
   again.resume();
-  EXPECT_EQ(again.episodes_done(), 4);
+  EXPECT_EQ(again.episodes_done(), 2);
+  fs::remove_all(dir);
+}
+
+// A trainer that is not resumed does not start a finished run over: its
+// episodes.csv and checkpoint stay as they were.
+TEST(Checkpoint, RunWithoutResumeOnAnExistingRunIsRefused) {
+  const std::string dir = trained_run("again");
+  const std::string episodes = test_support::read_text(dir + "/episodes.csv");
+  Trainer t(load_coopt_config(kCi, kRunSets), dir);
+  EXPECT_NE(error_of([&] { t.run(); }).find("already holds a run"), std::string::npos);
+  EXPECT_EQ(test_support::read_text(dir + "/episodes.csv"), episodes);
+  EXPECT_EQ(read_checkpoint_info(dir).episodes, 4);
   fs::remove_all(dir);
 }
 
