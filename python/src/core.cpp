@@ -598,8 +598,7 @@ PYBIND11_MODULE(_core, m) {
   });
   m.def("termination_names", [] {
     std::vector<std::string> names;
-    for (int t = 0; t <= static_cast<int>(task::Termination::step_cap); ++t)
-      names.push_back(task::termination_name(static_cast<task::Termination>(t)));
+    for (const auto& row : enum_names(task::Termination{})) names.push_back(row.name);
     return names;
   });
   m.def("cpp_loop_seconds",

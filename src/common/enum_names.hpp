@@ -11,6 +11,7 @@
 #pragma once
 
 #include <array>  // for the tables
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 
@@ -41,6 +42,23 @@ bool enum_from_name(const std::string& name, E& out) {
       return true;
     }
   return false;
+}
+
+// True when the table lists the values 0, 1, 2, ... in order, so that a
+// value's row is at its index (name_at; check with static_assert).
+template <class E>
+constexpr bool in_value_order() {
+  int i = 0;
+  for (const auto& row : enum_names(E{}))
+    if (static_cast<int>(row.value) != i++) return false;
+  return true;
+}
+
+// The name of `e`, without a search or a string: for tables in value order.
+template <class E>
+constexpr const char* name_at(E e) {
+  static_assert(in_value_order<E>(), "name_at needs a table in value order");
+  return enum_names(e)[static_cast<std::size_t>(e)].name;
 }
 
 // All names in table order, e.g. "huber | mse".

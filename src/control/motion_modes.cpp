@@ -8,20 +8,6 @@
 
 namespace comorph::control {
 
-const char* mode_name(MotionMode m) {
-  switch (m) {
-    case MotionMode::flat: return "flat";
-    case MotionMode::stair: return "stair";
-  }
-  return "?";
-}
-
-MotionMode parse_mode(const std::string& name) {
-  if (name == "flat") return MotionMode::flat;
-  if (name == "stair") return MotionMode::stair;
-  throw std::invalid_argument("unknown motion mode '" + name + "' (flat, stair)");
-}
-
 void compute_command(const MotionParams& p, MotionMode mode, const float* action, double t,
                      int modules, double wheel_radius, double max_wheel_speed, MotorCommand& out) {
   double a[kActionSize];

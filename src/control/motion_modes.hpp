@@ -20,6 +20,7 @@
 #include <array>
 #include <string>
 
+#include "common/enum_names.hpp"
 #include "morphology/configuration.hpp"  // kMaxModules
 
 namespace comorph::control {
@@ -27,8 +28,10 @@ namespace comorph::control {
 inline constexpr int kActionSize = 5;
 
 enum class MotionMode : int { flat = 0, stair = 1 };
-const char* mode_name(MotionMode m);
-MotionMode parse_mode(const std::string& name);  // throws std::invalid_argument
+constexpr auto enum_names(MotionMode) {
+  return std::array{EnumName{MotionMode::flat, "flat"}, EnumName{MotionMode::stair, "stair"}};
+}
+inline const char* mode_name(MotionMode m) { return name_at(m); }
 
 struct ModeWeights {
   double w1;  // straight-speed weight (Eq. 4)

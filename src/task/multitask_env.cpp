@@ -7,20 +7,6 @@
 
 namespace comorph::task {
 
-const char* termination_name(Termination t) {
-  switch (t) {
-    case Termination::none: return "none";
-    case Termination::success: return "success";
-    case Termination::collision: return "collision";
-    case Termination::overturned: return "overturned";
-    case Termination::left_area: return "left_area";
-    case Termination::battery_empty: return "battery_empty";
-    case Termination::physics_unstable: return "physics_unstable";
-    case Termination::step_cap: return "step_cap";
-  }
-  return "?";
-}
-
 EnvSpec MultiTaskEnv::spec(const EnvConfig& config) {
   const sim::RobotParams& r = config.robot;
   EnvSpec s;

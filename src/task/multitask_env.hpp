@@ -33,7 +33,19 @@ enum class Termination : int {
   physics_unstable,  // NaN or a MuJoCo bad-qacc/qpos/qvel warning (r_u)
   step_cap,          // max_steps reached (truncation, no r_u)
 };
-const char* termination_name(Termination t);
+constexpr auto enum_names(Termination) {
+  using T = Termination;
+  return std::array{EnumName{T::none, "none"},
+                    EnumName{T::success, "success"},
+                    EnumName{T::collision, "collision"},
+                    EnumName{T::overturned, "overturned"},
+                    EnumName{T::left_area, "left_area"},
+                    EnumName{T::battery_empty, "battery_empty"},
+                    EnumName{T::physics_unstable, "physics_unstable"},
+                    EnumName{T::step_cap, "step_cap"}};
+}
+// The name of episodes.csv's termination column.
+inline const char* termination_name(Termination t) { return name_at(t); }
 
 struct EpisodeSpec {
   std::uint64_t seed = 0;    // draws the scene (stair height, obstacles, target, start noise)

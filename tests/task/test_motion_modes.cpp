@@ -77,8 +77,11 @@ TEST(MotionModes, CtrlLayoutAndNames) {
   EXPECT_EQ(ctrl[5], 2);
   EXPECT_EQ(ctrl[6], 3);
   EXPECT_EQ(ctrl[7], 4);
-  EXPECT_EQ(control::parse_mode("stair"), MotionMode::stair);
-  EXPECT_THROW(control::parse_mode("swim"), std::invalid_argument);
+  EXPECT_STREQ(control::mode_name(MotionMode::stair), "stair");
+  MotionMode mode = MotionMode::flat;
+  EXPECT_TRUE(enum_from_name("stair", mode));
+  EXPECT_EQ(mode, MotionMode::stair);
+  EXPECT_FALSE(enum_from_name("swim", mode));
   EXPECT_THROW(control::motion_params_from_yaml("stair:\n  w9: 1\n", "motion.yaml"), std::runtime_error);
   EXPECT_EQ(control::motion_params_from_yaml("stair:\n  w1: 0.3\n", "motion.yaml").stair.w1, 0.3);
 }
