@@ -7,10 +7,8 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
-#include <sstream>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -22,10 +20,7 @@
 #include "coopt/trainer.hpp"
 #include "report/episode_record.hpp"
 #include "report/metrics.hpp"
-#include "report/run_dir.hpp"
-#include "common/file_io.hpp"
 #include "common/run_lock.hpp"
-#include "common/yaml_fields.hpp"
 
 namespace comorph::cli {
 namespace {
