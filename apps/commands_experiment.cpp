@@ -36,31 +36,51 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// One column of a paper table: a run directory, the keys that make it that
-// column (applied after the user's --set), the test scenarios it is evaluated on.
+// One run of an experiment: a run directory, the keys that make it that run
+// (applied after the user's --set), the test scenarios it is evaluated on.
 struct Column {
   std::string name;
   std::vector<std::string> sets;
   std::vector<std::string> scenarios;
 };
 
-std::vector<Column> columns_of_table(int table) {
-  const std::vector<std::string> hierarchical_td3 = {"trainer.mode=hierarchical", "trainer.motion_algo=td3"};
-  if (table == 1) {
-    std::vector<Column> columns = {{"hier-td3", hierarchical_td3, {"default"}}};
-    // A fixed chain has no DQN, so no DQN refit either: its motion model gets
-    // the hierarchy's budget (warm-up + training episodes; the refit's are the DQN's alone).
-    for (int n = 2; n <= 10; n += 2)
-      columns.push_back({fmt::format("fixed-{}", n),
-                         {"trainer.mode=fixed", fmt::format("trainer.fixed_modules={}", n), "trainer.motion_algo=td3",
-                          "trainer.config_refit_episodes=0"},
-                         {"default"}});
-    return columns;
+// The runs a paper table compares with, derived from the `match` of its
+// columns in configs/reference/paper-tables.yaml: the matrix is that data, so a
+// column added there is trained here. Columns that match the same run (Table
+// II's TD3 hierarchy on four scenarios) become one run with several evaluations.
+std::vector<Column> columns_of_table(const comorph::report::PaperReference& paper, int table) {
+  const comorph::report::PaperTable* found = nullptr;
+  std::string ids;
+  for (const auto& t : paper.tables) {
+    ids += (ids.empty() ? "" : " or ") + std::to_string(t.id);
+    if (t.id == table) found = &t;
   }
-  if (table == 2)
-    return {{"hier-td3", hierarchical_td3, {"default", "obstacles7", "obstacles8", "mixed"}},
-            {"hier-sac", {"trainer.mode=hierarchical", "trainer.motion_algo=sac"}, {"default"}}};
-  throw std::runtime_error(fmt::format("experiment: --table must be 1 or 2, got {}", table));
+  if (!found) throw std::runtime_error(fmt::format("experiment: --table must be {}, got {}", ids, table));
+  std::vector<Column> columns;
+  for (const auto& paper_column : found->columns) {
+    const auto& m = paper_column.match;
+    Column c;
+    if (m.kind == "hierarchical") {
+      c.name = "hier-" + m.algo;
+      c.sets = {"trainer.mode=hierarchical", "trainer.motion_algo=" + m.algo};
+    } else if (m.kind == "fixed" && m.modules > 0) {
+      c.name = fmt::format("fixed-{}", m.modules) + (m.algo == "td3" ? "" : "-" + m.algo);
+      // A fixed chain has no DQN, so no DQN refit either: its motion model gets
+      // the hierarchy's budget (warm-up + training episodes; the refit's are the DQN's alone).
+      c.sets = {"trainer.mode=fixed", fmt::format("trainer.fixed_modules={}", m.modules),
+                "trainer.motion_algo=" + m.algo, "trainer.config_refit_episodes=0"};
+    } else {
+      throw std::runtime_error(fmt::format("{}: table {}, column '{}': match needs kind hierarchical, or fixed with "
+                                           "modules, to be trained (got kind '{}', modules {})",
+                                           comorph::report::default_paper_reference_path(), table,
+                                           paper_column.label, m.kind, m.modules));
+    }
+    auto same = std::find_if(columns.begin(), columns.end(), [&](const Column& o) { return o.name == c.name; });
+    if (same == columns.end()) same = columns.insert(columns.end(), c);
+    if (std::find(same->scenarios.begin(), same->scenarios.end(), m.eval_scenario) == same->scenarios.end())
+      same->scenarios.push_back(m.eval_scenario);
+  }
+  return columns;
 }
 
 // Options of one `comorph experiment` call.
@@ -71,6 +91,7 @@ struct ExperimentOptions {
   std::string out;
   std::string only;        // run just this column ("" = all)
   int eval_episodes = 0;   // 0 = eval.episodes of the config
+  int eval_seed = -1;      // first evaluation seed; -1 = eval.seed of the config
 };
 
 // What happened to one column in this call (for the closing summary).
@@ -125,7 +146,8 @@ bool train_column(const ExperimentOptions& o, const Column& column, const comorp
 }
 
 void run_experiment(const ExperimentOptions& o) {
-  std::vector<Column> columns = columns_of_table(o.table);
+  const auto paper = comorph::report::load_paper_reference(comorph::report::default_paper_reference_path());
+  std::vector<Column> columns = columns_of_table(paper, o.table);
   if (!o.only.empty()) {
     std::vector<Column> picked;
     std::string names;
@@ -164,7 +186,7 @@ void run_experiment(const ExperimentOptions& o) {
     for (const auto& scenario : column.scenarios) {
       if (fs::exists(fs::path(run_dir) / ("eval-" + scenario + ".json"))) continue;
       const auto start = Clock::now();
-      comorph::cli::eval_run(run_dir, scenario, o.eval_episodes, -1, 0);
+      comorph::cli::eval_run(run_dir, scenario, o.eval_episodes, o.eval_seed, 0);
       t.eval_wall_s += std::chrono::duration<double>(Clock::now() - start).count();
     }
     times.push_back(t);
@@ -175,8 +197,8 @@ void run_experiment(const ExperimentOptions& o) {
   // call, or one table of two, shows what exists so far).
   std::vector<comorph::report::RunDir> runs;
   std::vector<std::string> run_dirs;
-  for (const int table : {1, 2})
-    for (const auto& column : columns_of_table(table)) {
+  for (const auto& table : paper.tables)
+    for (const auto& column : columns_of_table(paper, table.id)) {
       const std::string dir = (fs::path(o.out) / column.name).string();
       if (std::find(run_dirs.begin(), run_dirs.end(), dir) != run_dirs.end()) continue;
       try {
@@ -186,7 +208,6 @@ void run_experiment(const ExperimentOptions& o) {
         // not trained or evaluated yet: its cells show "—"
       }
     }
-  const auto paper = comorph::report::load_paper_reference(comorph::report::default_paper_reference_path());
   std::string table_md;
   for (const auto& t : paper.tables) {
     if (t.id != o.table) continue;
@@ -234,6 +255,9 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   ex->add_option("--only", options.only, "run only this column (e.g. fixed-4); the table shows what exists");
   ex->add_option("--eval-episodes", options.eval_episodes, "evaluation episodes per scenario (default: eval.episodes)")
       ->check(comorph::cli::whole_in(1, 1000000));
+  ex->add_option("--eval-seed", options.eval_seed,
+                 "first seed of the evaluation episodes (default: eval.seed); report figures from seeds no training used")
+      ->check(comorph::cli::whole_in(0, 2000000000));
   ex->callback([] { run_experiment(options); });
 }};
 

@@ -6,10 +6,13 @@
 
 #include <unistd.h>
 
+#include <cstdlib>
+
 #include <algorithm>
 #include <filesystem>
 #include <string>
 
+#include "common/file_io.hpp"
 #include "support/test_support.hpp"
 
 namespace {
@@ -70,7 +73,8 @@ TEST(Experiment, FixedColumnOfAPresetWithADqnRefitTrainsTheMotionBudgetOnly) {
   fs::remove_all(out);
   std::string log;
   ASSERT_EQ(run_cli("experiment --table 1 --only fixed-2 --config " + kCi +
-                        " --set trainer.config_refit_episodes=3 --eval-episodes 3 --out " + out.string(),
+                        " --set trainer.config_refit_episodes=3 --eval-episodes 3 --eval-seed 8123000 --out " +
+                        out.string(),
                     log),
             0)
       << log;
@@ -78,6 +82,8 @@ TEST(Experiment, FixedColumnOfAPresetWithADqnRefitTrainsTheMotionBudgetOnly) {
   EXPECT_EQ(std::count(episodes.begin(), episodes.end(), '\n'), 1 + 2 + 4);  // header, ci.yaml's 2 + 4 episodes
   EXPECT_NE(read_text(out / "fixed-2/config.yaml").find("config_refit_episodes: 0"), std::string::npos);
   EXPECT_TRUE(fs::exists(out / "fixed-2/eval-default.json"));
+  // --eval-seed: the evaluation's episodes start at that seed, not at eval.seed.
+  EXPECT_NE(read_text(out / "fixed-2/eval-default-episodes.csv").find("\n0,8123000,default,"), std::string::npos);
   fs::remove_all(out);
 }
 
@@ -92,6 +98,44 @@ TEST(Experiment, BadTableOrColumnIsNamedBeforeAnyTraining) {
   EXPECT_NE(run_cli("experiment --table 1 --set trainer.epsiodes=2 --config " + kCi + " --out " + out.string(), log), 0);
   EXPECT_NE(log.find("trainer.epsiodes"), std::string::npos) << log;
   EXPECT_FALSE(fs::exists(out));
+}
+
+// The matrix is the data of configs/reference/paper-tables.yaml: a column
+// added there (a fixed chain of 3 modules) is a column of the experiment, its
+// keys built from its `match`, and a column whose match cannot be trained is
+// refused naming the file and the column.
+TEST(Experiment, ColumnsComeFromThePaperTablesFile) {
+  const fs::path resources = fs::temp_directory_path() / ("comorph_experiment_data_" + std::to_string(::getpid()));
+  fs::remove_all(resources);
+  fs::create_directories(resources);
+  fs::copy(std::string(COMORPH_SOURCE_DIR) + "/configs", resources / "configs", fs::copy_options::recursive);
+  const fs::path tables = resources / "configs/reference/paper-tables.yaml";
+  std::string text = read_text(tables);
+  const std::string fixed2 = "      - label: \"Fixed 2\"\n";
+  const auto at = text.find(fixed2);
+  ASSERT_NE(at, std::string::npos);
+  text.insert(at, "      - label: \"Fixed 3\"\n        match: {kind: fixed, modules: 3, algo: td3, eval: default}\n");
+  comorph::write_file_atomic(tables.string(), text);
+
+  const std::string command = "experiment --table 1 --only fixed-3 --config " + kCi + " --out " +
+                              (resources / "out").string() + " --set trainer.epsiodes=2";
+  std::string log;
+  // The repository's file has no such column.
+  EXPECT_NE(run_cli(command, log), 0);
+  EXPECT_NE(log.find("has no column 'fixed-3'"), std::string::npos) << log;
+  // With the edited file the call gets past the column, as far as its keys.
+  ::setenv("COMORPH_RESOURCES", resources.c_str(), 1);
+  EXPECT_NE(run_cli(command, log), 0);
+  EXPECT_EQ(log.find("no column"), std::string::npos) << log;
+  EXPECT_NE(log.find("trainer.epsiodes"), std::string::npos) << log;
+
+  // A fixed column without a module count cannot be trained: named with the file.
+  text.replace(text.find("{kind: fixed, modules: 3,"), 25, "{kind: fixed,");
+  comorph::write_file_atomic(tables.string(), text);
+  EXPECT_NE(run_cli(command, log), 0);
+  EXPECT_NE(log.find("paper-tables.yaml: table 1, column 'Fixed 3'"), std::string::npos) << log;
+  ::unsetenv("COMORPH_RESOURCES");
+  fs::remove_all(resources);
 }
 
 }  // namespace
