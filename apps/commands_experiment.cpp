@@ -47,7 +47,7 @@ struct Column {
 // The runs a paper table compares with, derived from the `match` of its
 // columns in configs/reference/paper-tables.yaml: the matrix is that data, so a
 // column added there is trained here. Columns that match the same run (Table
-// II's TD3 hierarchy on four scenarios) become one run with several evaluations.
+// II's TD3 hierarchy on three scenarios) become one run with several evaluations.
 std::vector<Column> columns_of_table(const comorph::report::PaperReference& paper, int table) {
   const comorph::report::PaperTable* found = nullptr;
   std::string ids;
@@ -74,6 +74,11 @@ std::vector<Column> columns_of_table(const comorph::report::PaperReference& pape
                                            "modules, to be trained (got kind '{}', modules {})",
                                            comorph::report::default_paper_reference_path(), table,
                                            paper_column.label, m.kind, m.modules));
+    }
+    // A run trained in another scenario than the default is its own run.
+    if (m.train_scenario != "default") {
+      c.name += "-" + m.train_scenario;
+      c.sets.push_back("trainer.scenario=" + m.train_scenario);
     }
     auto same = std::find_if(columns.begin(), columns.end(), [&](const Column& o) { return o.name == c.name; });
     if (same == columns.end()) same = columns.insert(columns.end(), c);

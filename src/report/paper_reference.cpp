@@ -61,6 +61,7 @@ PaperReference load_paper_reference(const std::string& path) {
       pc.match.algo = get<std::string>(match, "algo", where + ".match");
       pc.match.eval_scenario = get<std::string>(match, "eval", where + ".match");
       if (match["modules"]) pc.match.modules = get<int>(match, "modules", where + ".match");
+      if (match["train"]) pc.match.train_scenario = get<std::string>(match, "train", where + ".match");
       pc.time_s = get_or_nan(col, "time_s", where);
       pc.energy_J = get_or_nan(col, "energy_J", where);
       pc.F = get_or_nan(col, "F", where);

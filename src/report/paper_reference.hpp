@@ -14,6 +14,7 @@ struct RunMatch {
   int modules = 0;            // modules of a fixed run; 0 = any
   std::string algo;           // td3 | sac
   std::string eval_scenario;  // read from eval-<eval_scenario>.json
+  std::string train_scenario = "default";  // the run's training scenario (run.yaml `scenario`)
 };
 
 // One column of a paper table. Values the paper does not give are NaN / absent.

@@ -33,7 +33,8 @@ double lookup(const std::map<std::string, double>& m, const std::string& key) {
 
 bool matches(const RunDir& run, const RunMatch& match) {
   return run.info.kind == match.kind && run.info.algo == match.algo &&
-         (match.modules == 0 || run.info.modules == match.modules) && run.evals.count(match.eval_scenario);
+         (match.modules == 0 || run.info.modules == match.modules) && run.info.scenario == match.train_scenario &&
+         run.evals.count(match.eval_scenario);
 }
 
 const RunDir* find_run(const std::vector<RunDir>& runs, const RunMatch& match) {

@@ -31,15 +31,19 @@ TEST(Experiment, Table2TrainsEveryColumnWritesTheTableAndResumesWithoutRetrainin
   std::string log;
   ASSERT_EQ(run_cli(command, log), 0) << log;
 
-  // Table II: the TD3 hierarchy (default, 7 and 8 obstacles, mixed) and the SAC hierarchy.
+  // Table II: the TD3 hierarchy (default, 7 and 8 obstacles), the one trained
+  // on the mixed scene (evaluated there) and the SAC hierarchy.
   for (const char* f : {"hier-td3/eval-default.json", "hier-td3/eval-obstacles7.json", "hier-td3/eval-obstacles8.json",
-                        "hier-td3/eval-mixed.json", "hier-sac/eval-default.json", "table-2.md", "report/report.md",
-                        "report/report.html"})
+                        "hier-td3-mixed/eval-mixed.json", "hier-sac/eval-default.json", "table-2.md",
+                        "report/report.md", "report/report.html"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   EXPECT_FALSE(fs::exists(out / "fixed-2"));  // Table I's columns are not Table II's
+  EXPECT_FALSE(fs::exists(out / "hier-td3/eval-mixed.json"));
   EXPECT_NE(read_text(out / "hier-sac/run.yaml").find("algo: sac"), std::string::npos);
+  EXPECT_NE(read_text(out / "hier-td3-mixed/run.yaml").find("scenario: mixed"), std::string::npos);
   const std::string table = read_text(out / "table-2.md");
-  for (const char* cell : {"SAC, default [hier-sac]", "TD3, 8 obstacles [hier-td3]", "/ 3.24", "/ 89.3", "F(H)"})
+  for (const char* cell :
+       {"SAC, default [hier-sac]", "TD3, 8 obstacles [hier-td3]", "TD3, mixed [", "/ 3.24", "/ 89.3", "F(H)"})
     EXPECT_NE(table.find(cell), std::string::npos) << cell << " not in\n" << table;
   EXPECT_EQ(table.find("—"), std::string::npos) << "a column has no run:\n" << table;
   // The report of the tiny runs: both tables, a section per run, the training curves.

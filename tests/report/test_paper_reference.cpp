@@ -24,6 +24,9 @@ TEST(PaperReference, LoadsBothTablesInThePapersLayout) {
   EXPECT_EQ(ref.tables[1].id, 2);
   EXPECT_EQ(ref.tables[1].columns[1].match.algo, "sac");
   EXPECT_EQ(ref.tables[1].columns[3].match.eval_scenario, "obstacles8");
+  // The training scenario: default unless given (the mixed column's run trains on the mixed scene).
+  EXPECT_EQ(ref.tables[1].columns[3].match.train_scenario, "default");
+  EXPECT_EQ(ref.tables[1].columns[4].match.train_scenario, "mixed");
   EXPECT_EQ(default_paper_reference_path(), std::string(COMORPH_TEST_REFERENCE));
 }
 
