@@ -10,7 +10,7 @@
 #include "cli_scenario.hpp"
 #include "morphology/configuration.hpp"
 #include "command_registry.hpp"
-#include "run_steps.hpp"
+#include "workflows/run_steps.hpp"
 
 namespace {
 
@@ -23,7 +23,7 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   tr->add_option("--out", out, "new run directory, e.g. runs/quick");
   tr->add_option("--resume", resume, "continue the run in this directory from its last checkpoint");
   tr->callback([] {
-    if (comorph::cli::train_run(config, sets, out, resume)) return;
+    if (comorph::workflows::train_run(config, sets, out, resume)) return;
     std::fprintf(stderr, "continue with: comorph train --resume %s\n", (resume.empty() ? out : resume).c_str());
     std::fflush(stderr);
     std::exit(130);  // interrupted: a calling script (make run) stops here too
@@ -45,13 +45,13 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
                  "drive a fixed chain of this many modules with the run's motion model (no configuration model, "
                  "no shedding): what the motion model can do with each body; writes eval-<scenario>-modules<N>.*")
       ->check(comorph::cli::whole_in(comorph::kMinModules, comorph::kMaxModules));
-  ev->callback([] { comorph::cli::eval_run(run, scenario, episodes, seed, workers, forced_modules); });
+  ev->callback([] { comorph::workflows::eval_run(run, scenario, episodes, seed, workers, forced_modules); });
 
   auto* ex = app.add_subcommand("export", "copy a trained run's policies (no replay buffers) and logs, e.g. into results/");
   static std::string export_run, export_out;
   ex->add_option("--run", export_run, "trained run directory")->required();
   ex->add_option("--out", export_out, "destination directory, e.g. results/standard-hier-td3")->required();
-  ex->callback([] { comorph::cli::export_run(export_run, export_out); });
+  ex->callback([] { comorph::workflows::export_run(export_run, export_out); });
 }};
 
 }  // namespace

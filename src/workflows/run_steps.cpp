@@ -15,14 +15,14 @@
 
 #include <fmt/format.h>
 
-#include "run_steps.hpp"
+#include "workflows/run_steps.hpp"
 #include "coopt/config.hpp"
 #include "coopt/trainer.hpp"
 #include "report/episode_record.hpp"
 #include "report/metrics.hpp"
 #include "common/run_lock.hpp"
 
-namespace comorph::cli {
+namespace comorph::workflows {
 namespace {
 namespace fs = std::filesystem;
 using comorph::coopt::CooptConfig;
@@ -222,4 +222,4 @@ std::uintmax_t export_run(const std::string& run_dir, const std::string& out) {
   return bytes;
 }
 
-}  // namespace comorph::cli
+}  // namespace comorph::workflows

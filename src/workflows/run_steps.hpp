@@ -8,7 +8,7 @@
 
 #include "report/metrics.hpp"
 
-namespace comorph::cli {
+namespace comorph::workflows {
 
 // Trains a new run into `out` (config file + `--set`s) or, when `resume` is
 // given, continues that run from its last checkpoint. SIGINT/SIGTERM finish
@@ -41,4 +41,4 @@ report::Metrics eval_run(const std::string& run_dir, const std::string& scenario
 // copy evaluates like the run; it cannot resume training. Returns its bytes.
 std::uintmax_t export_run(const std::string& run_dir, const std::string& out);
 
-}  // namespace comorph::cli
+}  // namespace comorph::workflows
