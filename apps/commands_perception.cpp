@@ -12,7 +12,7 @@
 //                              [--config-dir configs/sim]
 //
 // `dataset` and `prepare` take their images from the simulator
-// (coopt/scene_dataset.hpp: scripted-pilot runs and level views of seeded
+// (perception_sim/scene_dataset.hpp: scripted-pilot runs and level views of seeded
 // scenes, labelled from ground truth); docs/perception.md, "Data from the
 // simulator".
 #include <spdlog/spdlog.h>
@@ -31,7 +31,7 @@
 #include "common/file_io.hpp"
 #include "common/resources.hpp"
 #include "command_registry.hpp"
-#include "coopt/scene_dataset.hpp"
+#include "perception_sim/scene_dataset.hpp"
 #include "perception/dataset.hpp"
 #include "perception/perception_config.hpp"
 #include "perception/scene_classifier.hpp"
@@ -136,15 +136,15 @@ void run_eval(const EvalOptions& o) {
 
 // ---- data from the simulator: `dataset` and `prepare` ----
 
-namespace coopt = comorph::coopt;
+namespace perception_sim = comorph::perception_sim;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 // One stderr line about every tenth of the seeds (and the last).
-coopt::SeedProgress seed_progress(const std::string& what) {
-  return [what](int done, int total, const coopt::SceneDatasetStats& st) {
+perception_sim::SeedProgress seed_progress(const std::string& what) {
+  return [what](int done, int total, const perception_sim::SceneDatasetStats& st) {
     const int every = std::max(1, total / 10);
     if (done % every == 0 || done == total)
       std::cerr << fmt::format("{}: seed {}/{}, {} images, {} control steps simulated, {:.1f} s\n", what, done,
@@ -154,14 +154,14 @@ coopt::SeedProgress seed_progress(const std::string& what) {
 
 struct DatasetOptions {
   std::string out, seeds = "1:30", config_dir;  // "": configs/sim of resource_dir()
-  int frames_per_seed = coopt::SceneDatasetParams{}.frames_per_seed;
-  double run_fraction = coopt::SceneDatasetParams{}.run_fraction;
+  int frames_per_seed = perception_sim::SceneDatasetParams{}.frames_per_seed;
+  double run_fraction = perception_sim::SceneDatasetParams{}.run_fraction;
   std::uint64_t seed = 1;
 };
 
 void run_dataset(const DatasetOptions& o) {
-  coopt::SceneDatasetParams p;
-  coopt::parse_seed_range(o.seeds, "--seeds", p.first_seed, p.last_seed);
+  perception_sim::SceneDatasetParams p;
+  perception_sim::parse_seed_range(o.seeds, "--seeds", p.first_seed, p.last_seed);
   p.frames_per_seed = o.frames_per_seed;
   p.run_fraction = o.run_fraction;
   p.seed = o.seed;
@@ -172,9 +172,9 @@ void run_dataset(const DatasetOptions& o) {
                            "{}x{} pixels, generator seed {}\n",
                            p.first_seed, p.last_seed, p.seeds(), p.frames_per_seed, 100 * p.run_fraction,
                            env.robot.depth_height, env.robot.depth_width, p.seed);
-  const coopt::SceneDatasetStats st = coopt::write_scene_dataset(o.out, env, p, seed_progress("dataset"));
-  std::cout << "wrote " << o.out << ": " << coopt::format_class_balance(st) << "\n";
-  std::cout << fmt::format("{}; {} control steps simulated; {:.1f} s\n", coopt::format_run_ends(st), st.run_steps,
+  const perception_sim::SceneDatasetStats st = perception_sim::write_scene_dataset(o.out, env, p, seed_progress("dataset"));
+  std::cout << "wrote " << o.out << ": " << perception_sim::format_class_balance(st) << "\n";
+  std::cout << fmt::format("{}; {} control steps simulated; {:.1f} s\n", perception_sim::format_run_ends(st), st.run_steps,
                            st.seconds);
 }
 
@@ -184,8 +184,8 @@ struct PrepareOptions {
   // Held-out accuracy on this data plateaus after 2-3 epochs: 6 (not the
   // preset's 10) keeps `prepare` at ~1.5 min on an idle 2-core machine.
   int epochs = 6;
-  int frames_per_seed = coopt::SceneDatasetParams{}.frames_per_seed;
-  double run_fraction = coopt::SceneDatasetParams{}.run_fraction;
+  int frames_per_seed = perception_sim::SceneDatasetParams{}.frames_per_seed;
+  double run_fraction = perception_sim::SceneDatasetParams{}.run_fraction;
   std::uint64_t seed = 1;
 };
 
@@ -216,9 +216,9 @@ void run_prepare(PrepareOptions o) {
   if (cfg.classifier.classes != 3)
     throw std::runtime_error(fmt::format("{}: classifier.classes {}: the simulator labels 3 scene classes",
                                          o.config, cfg.classifier.classes));
-  coopt::SceneDatasetParams train_p, eval_p;
-  coopt::parse_seed_range(o.train_seeds, "--train-seeds", train_p.first_seed, train_p.last_seed);
-  coopt::parse_seed_range(o.eval_seeds, "--eval-seeds", eval_p.first_seed, eval_p.last_seed);
+  perception_sim::SceneDatasetParams train_p, eval_p;
+  perception_sim::parse_seed_range(o.train_seeds, "--train-seeds", train_p.first_seed, train_p.last_seed);
+  perception_sim::parse_seed_range(o.eval_seeds, "--eval-seeds", eval_p.first_seed, eval_p.last_seed);
   if (!(train_p.last_seed < eval_p.first_seed || eval_p.last_seed < train_p.first_seed))
     throw std::runtime_error(fmt::format("--train-seeds {} and --eval-seeds {} overlap: held-out seeds must be disjoint",
                                          o.train_seeds, o.eval_seeds));
@@ -227,7 +227,7 @@ void run_prepare(PrepareOptions o) {
   train_p.seed = eval_p.seed = o.seed;
   for (const std::string& err : {train_p.validate(), eval_p.validate()})
     if (!err.empty()) throw std::runtime_error(err);
-  coopt::EpisodeSwitchParams episodes;
+  perception_sim::EpisodeSwitchParams episodes;
   episodes.first_seed = eval_p.first_seed;
   episodes.last_seed = eval_p.last_seed;
   episodes.seed = o.seed;
@@ -250,13 +250,13 @@ void run_prepare(PrepareOptions o) {
                     train_p.frames_per_seed, o.seed));
 
     // ---- data ----
-    const coopt::SceneDataset train = coopt::make_scene_dataset(env, train_p, seed_progress("training data"));
-    const coopt::SceneDataset eval = coopt::make_scene_dataset(env, eval_p, seed_progress("held-out data"));
+    const perception_sim::SceneDataset train = perception_sim::make_scene_dataset(env, train_p, seed_progress("training data"));
+    const perception_sim::SceneDataset eval = perception_sim::make_scene_dataset(env, eval_p, seed_progress("held-out data"));
     perception::save_dataset((stage / "train.bin").string(), train.data);
     perception::save_dataset((stage / "eval.bin").string(), eval.data);
-    say(fmt::format("training data (train.bin): {}; {:.1f} s\n", coopt::format_class_balance(train.stats),
+    say(fmt::format("training data (train.bin): {}; {:.1f} s\n", perception_sim::format_class_balance(train.stats),
                     train.stats.seconds));
-    say(fmt::format("held-out data (eval.bin): {}; {:.1f} s\n", coopt::format_class_balance(eval.stats),
+    say(fmt::format("held-out data (eval.bin): {}; {:.1f} s\n", perception_sim::format_class_balance(eval.stats),
                     eval.stats.seconds));
 
     // ---- training ----
@@ -276,7 +276,7 @@ void run_prepare(PrepareOptions o) {
     say(perception::format_evaluation(r.eval, cfg.classifier));
     double source_accuracy[2] = {NAN, NAN};
     std::size_t source_count[2] = {0, 0};
-    for (const coopt::FrameSource src : {coopt::FrameSource::run, coopt::FrameSource::view}) {
+    for (const perception_sim::FrameSource src : {perception_sim::FrameSource::run, perception_sim::FrameSource::view}) {
       std::vector<std::size_t> idx;
       for (std::size_t i = 0; i < eval.info.size(); ++i)
         if (eval.info[i].source == src) idx.push_back(i);
@@ -286,19 +286,19 @@ void run_prepare(PrepareOptions o) {
       source_accuracy[k] = e.accuracy;
       source_count[k] = e.count;
       say(fmt::format("  {} frames: accuracy {:.2f} % ({} images)\n",
-                      src == coopt::FrameSource::run ? "scripted-run" : "level-view", 100 * e.accuracy, e.count));
+                      src == perception_sim::FrameSource::run ? "scripted-run" : "level-view", 100 * e.accuracy, e.count));
     }
 
     // ---- switch delay in real episodes on the held-out seeds ----
     perception::SceneClassifier::set_threads(1);
-    const coopt::EpisodeSwitchReport sw = coopt::evaluate_switching_in_episodes(
+    const perception_sim::EpisodeSwitchReport sw = perception_sim::evaluate_switching_in_episodes(
         env, r.model, cfg.switch_detector, episodes, [](int done, int total) {
           std::cerr << fmt::format("switch episodes: {}/{}\n", done, total);
         });
     const auto& d = cfg.switch_detector;
     say(fmt::format("switch detector: every {} control steps, last {} frames, > {:.0f} % agree\n", d.interval,
                     d.window, 100 * d.agreement));
-    say(coopt::format_episode_switch_report(sw));
+    say(perception_sim::format_episode_switch_report(sw));
     say(fmt::format("  ({:.1f} s)\n", sw.seconds));
 
     // ---- save ----

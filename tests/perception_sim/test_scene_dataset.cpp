@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "coopt/scene_dataset.hpp"
+#include "perception_sim/scene_dataset.hpp"
 #include "perception/dataset.hpp"
 #include "perception/training.hpp"
 #include "sim/scene.hpp"
@@ -29,8 +29,8 @@ const task::EnvConfig& env_config() {
 }
 
 // Small and quick: short runs, few frames a seed.
-coopt::SceneDatasetParams small(std::uint64_t first, std::uint64_t last, int frames = 24) {
-  coopt::SceneDatasetParams p;
+perception_sim::SceneDatasetParams small(std::uint64_t first, std::uint64_t last, int frames = 24) {
+  perception_sim::SceneDatasetParams p;
   p.first_seed = first;
   p.last_seed = last;
   p.frames_per_seed = frames;
@@ -45,13 +45,13 @@ std::vector<float> image(const perception::Dataset& d, std::size_t i) {
 
 TEST(SceneDataset, DeterministicForASeedAndPerScene) {
   const auto p = small(3, 4);
-  const coopt::SceneDataset a = coopt::make_scene_dataset(env_config(), p);
-  const coopt::SceneDataset b = coopt::make_scene_dataset(env_config(), p);
+  const perception_sim::SceneDataset a = perception_sim::make_scene_dataset(env_config(), p);
+  const perception_sim::SceneDataset b = perception_sim::make_scene_dataset(env_config(), p);
   ASSERT_EQ(a.data.size(), 2u * 24u);
   EXPECT_EQ(a.data.images, b.data.images);
   EXPECT_EQ(a.data.labels, b.data.labels);
   // A scene's images depend only on (seed, scene seed): seed 4 alone = the second half.
-  const coopt::SceneDataset only4 = coopt::make_scene_dataset(env_config(), small(4, 4));
+  const perception_sim::SceneDataset only4 = perception_sim::make_scene_dataset(env_config(), small(4, 4));
   ASSERT_EQ(only4.data.size(), 24u);
   for (std::size_t i = 0; i < only4.data.size(); ++i) {
     EXPECT_EQ(image(only4.data, i), image(a.data, 24 + i)) << i;
@@ -60,13 +60,13 @@ TEST(SceneDataset, DeterministicForASeedAndPerScene) {
   // Another generator seed draws other frames of the same scenes.
   auto q = p;
   q.seed = 2;
-  const coopt::SceneDataset c = coopt::make_scene_dataset(env_config(), q);
+  const perception_sim::SceneDataset c = perception_sim::make_scene_dataset(env_config(), q);
   EXPECT_NE(a.data.images, c.data.images);
 }
 
 TEST(SceneDataset, LabelsAreTheEnvGroundTruthAndImagesAreReproduced) {
   const auto p = small(5, 6, 30);
-  const coopt::SceneDataset d = coopt::make_scene_dataset(env_config(), p);
+  const perception_sim::SceneDataset d = perception_sim::make_scene_dataset(env_config(), p);
   ASSERT_EQ(d.data.size(), 60u);
   ASSERT_EQ(d.info.size(), 60u);
   task::MultiTaskEnv env(env_config());
@@ -74,9 +74,9 @@ TEST(SceneDataset, LabelsAreTheEnvGroundTruthAndImagesAreReproduced) {
   int runs = 0, views = 0;
   for (const std::uint64_t seed : {5u, 6u}) {
     // Replay the scene's scripted run and compare every recorded frame.
-    const task::EpisodeSpec spec = coopt::scene_episode(p, seed);
+    const task::EpisodeSpec spec = perception_sim::scene_episode(p, seed);
     env.reset(spec);
-    task::ScriptedPilot pilot = coopt::dataset_pilot();
+    task::ScriptedPilot pilot = perception_sim::dataset_pilot();
     pilot.plan(env);
     std::vector<std::vector<float>> frames{std::vector<float>(env.depth(), env.depth() + d.data.pixels())};
     std::vector<int> labels{env.scene_label()};
@@ -89,8 +89,8 @@ TEST(SceneDataset, LabelsAreTheEnvGroundTruthAndImagesAreReproduced) {
       labels.push_back(env.scene_label());
     }
     for (std::size_t i = 0; i < d.data.size(); ++i) {
-      const coopt::FrameInfo& f = d.info[i];
-      if (f.scene_seed != seed || f.source != coopt::FrameSource::run) continue;
+      const perception_sim::FrameInfo& f = d.info[i];
+      if (f.scene_seed != seed || f.source != perception_sim::FrameSource::run) continue;
       ++runs;
       EXPECT_EQ(f.modules, module_count(spec.configuration));
       ASSERT_GE(f.step, 0);
@@ -100,8 +100,8 @@ TEST(SceneDataset, LabelsAreTheEnvGroundTruthAndImagesAreReproduced) {
     }
     // Views: the same render from the recorded pose, labelled by the scene's ground truth.
     for (std::size_t i = 0; i < d.data.size(); ++i) {
-      const coopt::FrameInfo& f = d.info[i];
-      if (f.scene_seed != seed || f.source != coopt::FrameSource::view) continue;
+      const perception_sim::FrameInfo& f = d.info[i];
+      if (f.scene_seed != seed || f.source != perception_sim::FrameSource::view) continue;
       ++views;
       task::EpisodeSpec s = spec;
       s.variant = f.variant;
@@ -117,7 +117,7 @@ TEST(SceneDataset, LabelsAreTheEnvGroundTruthAndImagesAreReproduced) {
 }
 
 TEST(SceneDataset, AllClassesDepthRangeAndBalance) {
-  const coopt::SceneDataset d = coopt::make_scene_dataset(env_config(), small(1, 6, 30));
+  const perception_sim::SceneDataset d = perception_sim::make_scene_dataset(env_config(), small(1, 6, 30));
   ASSERT_EQ(d.data.size(), 180u);
   EXPECT_EQ(d.data.height, env_config().robot.depth_height);
   EXPECT_EQ(d.data.width, env_config().robot.depth_width);
@@ -137,8 +137,8 @@ TEST(SceneDataset, AllClassesDepthRangeAndBalance) {
 }
 
 TEST(SceneDataset, DisjointSeedRangesGiveDifferentImages) {
-  const coopt::SceneDataset a = coopt::make_scene_dataset(env_config(), small(1, 3));
-  const coopt::SceneDataset b = coopt::make_scene_dataset(env_config(), small(11, 13));
+  const perception_sim::SceneDataset a = perception_sim::make_scene_dataset(env_config(), small(1, 3));
+  const perception_sim::SceneDataset b = perception_sim::make_scene_dataset(env_config(), small(11, 13));
   std::set<std::vector<float>> seen;
   for (std::size_t i = 0; i < a.data.size(); ++i) seen.insert(image(a.data, i));
   int shared = 0;
@@ -152,9 +152,9 @@ TEST(SceneDataset, FileWriterMatchesMemoryAndLeavesNothingOnError) {
   fs::create_directories(dir);
   const std::string path = (dir / "d.bin").string();
   const auto p = small(2, 2);
-  const coopt::SceneDatasetStats st = coopt::write_scene_dataset(path, env_config(), p);
+  const perception_sim::SceneDatasetStats st = perception_sim::write_scene_dataset(path, env_config(), p);
   const perception::Dataset file = perception::load_dataset(path);
-  const coopt::SceneDataset mem = coopt::make_scene_dataset(env_config(), p);
+  const perception_sim::SceneDataset mem = perception_sim::make_scene_dataset(env_config(), p);
   EXPECT_EQ(file.labels, mem.data.labels);
   ASSERT_EQ(file.images.size(), mem.data.images.size());
   for (std::size_t i = 0; i < file.images.size(); ++i)
@@ -165,7 +165,7 @@ TEST(SceneDataset, FileWriterMatchesMemoryAndLeavesNothingOnError) {
   bad.run_fraction = 1.5;
   const std::string bad_path = (dir / "bad.bin").string();
   try {
-    coopt::write_scene_dataset(bad_path, env_config(), bad);
+    perception_sim::write_scene_dataset(bad_path, env_config(), bad);
     ADD_FAILURE() << "no error";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("run_fraction"), std::string::npos) << e.what();
@@ -177,15 +177,15 @@ TEST(SceneDataset, FileWriterMatchesMemoryAndLeavesNothingOnError) {
 
 TEST(SceneDataset, SeedRanges) {
   std::uint64_t a = 0, b = 0;
-  coopt::parse_seed_range("3:17", "--seeds", a, b);
+  perception_sim::parse_seed_range("3:17", "--seeds", a, b);
   EXPECT_EQ(a, 3u);
   EXPECT_EQ(b, 17u);
-  coopt::parse_seed_range("9", "--seeds", a, b);
+  perception_sim::parse_seed_range("9", "--seeds", a, b);
   EXPECT_EQ(a, 9u);
   EXPECT_EQ(b, 9u);
   for (const char* bad : {"5:2", "x:3", "1:", ":4", "-1:3", "1:2:3"}) {
     try {
-      coopt::parse_seed_range(bad, "--seeds", a, b);
+      perception_sim::parse_seed_range(bad, "--seeds", a, b);
       ADD_FAILURE() << bad << " accepted";
     } catch (const std::invalid_argument& e) {
       EXPECT_NE(std::string(e.what()).find("--seeds"), std::string::npos) << e.what();
@@ -199,8 +199,8 @@ TEST(SceneDataset, SeedRanges) {
 TEST(SceneDataset, SmallClassifierBeatsChanceOnHeldOutSeedsAndDetectsSwitches) {
   auto train_p = small(1, 14, 50);
   auto eval_p = small(501, 505, 50);
-  const coopt::SceneDataset train = coopt::make_scene_dataset(env_config(), train_p);
-  const coopt::SceneDataset eval = coopt::make_scene_dataset(env_config(), eval_p);
+  const perception_sim::SceneDataset train = perception_sim::make_scene_dataset(env_config(), train_p);
+  const perception_sim::SceneDataset eval = perception_sim::make_scene_dataset(env_config(), eval_p);
   perception::ClassifierParams cp;
   cp.width = 8;
   perception::TrainParams tp;
@@ -214,13 +214,13 @@ TEST(SceneDataset, SmallClassifierBeatsChanceOnHeldOutSeedsAndDetectsSwitches) {
             << perception::format_evaluation(r.eval, cp);
   EXPECT_GT(r.eval.accuracy, 0.70);  // chance ~0.33 (balanced); 80-89 % measured over 2 data x 4 training seeds
 
-  coopt::EpisodeSwitchParams ep;
+  perception_sim::EpisodeSwitchParams ep;
   ep.first_seed = 501;
   ep.last_seed = 502;
   ep.max_steps = 700;
   perception::SwitchDetectorParams det;
-  const coopt::EpisodeSwitchReport sw = coopt::evaluate_switching_in_episodes(env_config(), r.model, det, ep);
-  std::cout << coopt::format_episode_switch_report(sw);
+  const perception_sim::EpisodeSwitchReport sw = perception_sim::evaluate_switching_in_episodes(env_config(), r.model, det, ep);
+  std::cout << perception_sim::format_episode_switch_report(sw);
   EXPECT_EQ(sw.episodes, 2);
   // Both loops see the same true changes.
   EXPECT_EQ(sw.rule_only.detected + sw.rule_only.missed, sw.monitor.detected + sw.monitor.missed);

@@ -36,7 +36,7 @@
 #include "task/multitask_env.hpp"
 #include "task/scripted_pilot.hpp"
 
-namespace comorph::coopt {
+namespace comorph::perception_sim {
 
 enum class FrameSource : std::uint8_t {
   run = 0,   // recorded along a scripted-pilot run
@@ -182,4 +182,4 @@ EpisodeSwitchReport evaluate_switching_in_episodes(const task::EnvConfig& env,
 
 std::string format_episode_switch_report(const EpisodeSwitchReport& report);
 
-}  // namespace comorph::coopt
+}  // namespace comorph::perception_sim

@@ -1,6 +1,6 @@
 // Classifier data from the simulator, and the switch delay in real episodes
 // (scene_dataset.hpp).
-#include "coopt/scene_dataset.hpp"
+#include "perception_sim/scene_dataset.hpp"
 
 #include <fmt/format.h>
 
@@ -13,7 +13,7 @@
 
 #include "perception/scene_monitor.hpp"
 
-namespace comorph::coopt {
+namespace comorph::perception_sim {
 namespace {
 
 constexpr int kClasses = 3;  // sim::SceneLabel: stairs, obstacle field, target zone
@@ -431,4 +431,4 @@ std::string format_episode_switch_report(const EpisodeSwitchReport& r) {
          line("detector on ground-truth labels", r.rule_only, r.rule_only_max_delay);
 }
 
-}  // namespace comorph::coopt
+}  // namespace comorph::perception_sim
