@@ -78,7 +78,6 @@ std::vector<Column> columns_of_table(const comorph::report::PaperReference& pape
   return columns;
 }
 
-
 // What happened to one column in this call (for the closing summary).
 struct ColumnTimes {
   std::string name;
