@@ -31,6 +31,8 @@ struct SimOptions {
   int seeds = 3;
   bool quick = false;
   int shed_to = 0;
+  task::FlatSteering steering = task::FlatSteering::planned;
+  int scan_columns = 24;  // the obstacle scan's rays when steering by it (the standard preset's)
 };
 
 task::EnvConfig load_config(const std::string& dir) {
@@ -96,7 +98,8 @@ void run_physics_table(const SimOptions& o) {
 }
 
 void run_demo(const SimOptions& o) {
-  const task::EnvConfig c = load_config(o.config_dir);
+  task::EnvConfig c = load_config(o.config_dir);
+  if (o.steering == task::FlatSteering::scan && c.robot.scan_columns == 0) c.robot.scan_columns = o.scan_columns;
   task::MultiTaskEnv env(c);
   task::EpisodeSpec spec;
   spec.seed = o.seed;
@@ -114,6 +117,7 @@ void run_demo(const SimOptions& o) {
   task::ScriptedPilot pilot;
   // The stair gait the physics-table search picks (full amplitude, wave lag -0.5).
   pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};
+  pilot.params().flat_steering = o.steering;
   pilot.plan(env);
   float action[control::kActionSize];
   control::MotionMode mode = env.mode(), last_mode = env.mode();
@@ -195,8 +199,23 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   demo->add_option("--variant", o.variant, "standard | mixed");
   demo->add_option("--shed-to", o.shed_to, "after the stairs, shed tail modules down to this many (0 = keep)")
       ->check(cli::whole_in(0, kMaxModules));
+  static std::string steering = "planned";
+  demo->add_option("--pilot-steering", steering,
+                   "flat area: " + enum_name_list<task::FlatSteering>() +
+                       " (a path on the true layout | towards the scan's open direction nearest the target)")
+      ->check([](const std::string& v) {
+        task::FlatSteering s;
+        return enum_from_name(v, s) ? std::string() : "not one of " + enum_name_list<task::FlatSteering>();
+      });
+  demo->add_option("--scan-columns", o.scan_columns,
+                   "rays of the obstacle scan with --pilot-steering scan, where the config has none")
+      ->capture_default_str()
+      ->check(cli::whole_in(1, 1024));
   demo->add_option("--config-dir", o.config_dir, cli::kConfigDirHelp);
-  demo->callback([] { run_demo(o); });
+  demo->callback([] {
+    enum_from_name(steering, o.steering);
+    run_demo(o);
+  });
 }};
 
 }  // namespace

@@ -22,6 +22,7 @@
 #include "perception/perception_config.hpp"
 #include "rl/learner_params.hpp"
 #include "task/env_config.hpp"
+#include "task/pilot_params.hpp"
 #include "task/scenario.hpp"
 
 namespace comorph::coopt {
@@ -86,6 +87,12 @@ struct TrainerParams {
   // The pilot climbs with each chain length's own searched gait
   // (task::searched_stair_gaits); false: one gait (a0, a2, a3, a4) = (1, 1, -0.5, 1) for all.
   bool pilot_gait_per_modules = false;
+  // How the pilot steers on the flat area (task::FlatSteering): planned (a path
+  // on the true obstacle layout) | scan (towards the open direction of the
+  // obstacle scan nearest the goal: its labels depend only on what the motion
+  // model sees, so the model can follow them; planned labels differ between
+  // states the model cannot tell apart, and it dithered in front of obstacles).
+  task::FlatSteering pilot_flat_steering = task::FlatSteering::planned;
   // Every this-many-th episode after the warm-up that the motion model drives
   // is played without its exploration noise (its transitions still train it); 0 = none.
   int greedy_motion_interval = 0;

@@ -32,6 +32,7 @@ Trainer::Impl::Impl(const CooptConfig& c, const std::string& dir, TrainerCallbac
     pilot.params() = task::searched_stair_gaits();
   else
     pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};  // the gait the physics-table search picks
+  pilot.params().flat_steering = c.trainer.pilot_flat_steering;
 }
 
 double Trainer::Impl::wall() const {

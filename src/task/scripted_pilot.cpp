@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <queue>
+#include <stdexcept>
 
 namespace comorph::task {
 namespace {
@@ -68,7 +69,13 @@ void ScriptedPilot::act(const MultiTaskEnv& env, float a[control::kActionSize],
   // Steer along the planned path once module 1 is on the flat area (a long
   // chain's head reaches the obstacles while its tail is still climbing).
   const bool on_top = head[0] > env.world().layout().platform_x + 0.3;
-  if (on_top && !field_.empty()) {
+  if (on_top && p_.flat_steering == FlatSteering::scan) {
+    const sim::SceneLayout& s = env.world().layout();
+    const double goal_bearing = wrap(std::atan2(s.target_y - head[1], s.target_x - head[0]) - heading);
+    const double bearing = scan_target_bearing(env, goal_bearing, std::hypot(s.target_x - head[0], s.target_y - head[1]));
+    gx = head[0] + std::cos(heading + bearing);
+    gy = head[1] + std::sin(heading + bearing);
+  } else if (on_top && !field_.empty()) {
     // Walk down the distance field from module 1's cell for `lookahead` metres.
     int i = std::clamp(int(std::lround((head[0] - x0_) / cell_)), 0, nx_ - 1);
     int j = std::clamp(int(std::lround((head[1] - y0_) / cell_)), 0, ny_ - 1);
@@ -128,6 +135,42 @@ void ScriptedPilot::act(const MultiTaskEnv& env, float a[control::kActionSize],
     a[3] = 0.0f;
     a[4] = -1.0f;
   }
+}
+
+double ScriptedPilot::scan_target_bearing(const MultiTaskEnv& env, double goal_bearing, double goal_distance) const {
+  const sim::RobotParams& robot = env.config().robot;
+  const int rays = env.clearance_width();
+  if (robot.scan_columns <= 0)
+    throw std::logic_error("ScriptedPilot: flat_steering scan needs env.robot.scan_columns > 0");
+  const double fov = robot.scan_fov_x, step = fov / rays;
+  const float* scan = env.clearance();  // fraction of depth_max_range, ray 0 at the left
+  const double last_turn = env.state()[obs::kPrevAction + 1];
+  const double lookahead = std::min(p_.scan_lookahead_m, goal_distance);
+  auto bearing_of = [&](int j) { return 0.5 * fov - step * (j + 0.5); };
+  // Open: no scanned point in the corridor of half-width scan_corridor_m
+  // ahead along the bearing, up to the lookahead.
+  auto open = [&](double bearing) {
+    for (int k = 0; k < rays; ++k) {
+      const double r = scan[k] * robot.depth_max_range, d = bearing_of(k) - bearing;
+      const double along = r * std::cos(d), across = std::abs(r * std::sin(d));
+      if (scan[k] < 1.0f && along > 0 && along < lookahead && across < p_.scan_corridor_m) return false;
+    }
+    return true;
+  };
+  // The goal outside the fan: turn towards it (nothing is known there).
+  if (std::abs(goal_bearing) > 0.5 * fov) return goal_bearing;
+  if (open(goal_bearing)) return goal_bearing;
+  double best = 0, best_cost = 1e9;
+  for (int j = 0; j < rays; ++j) {
+    const double bearing = bearing_of(j);
+    if (!open(bearing)) continue;
+    double cost = std::abs(bearing - goal_bearing);
+    if (bearing * last_turn < 0 && std::abs(bearing) > step && std::abs(last_turn) > 0.2) cost += p_.scan_hysteresis_rad;
+    if (cost < best_cost) best_cost = cost, best = bearing;
+  }
+  if (best_cost < 1e9) return best;
+  // Nothing open: turn in place towards the side the last turn went (left when none).
+  return last_turn < 0 ? -0.5 * fov : 0.5 * fov;
 }
 
 PilotParams searched_stair_gaits() {

@@ -250,6 +250,13 @@ TEST(Settings, ZeroEpisodesWithZeroWarmupIsRefused) {
             std::string::npos);
 }
 
+TEST(Settings, ScanSteeringWithoutTheScanIsRefused) {
+  const std::string e = config_error({"trainer.pilot_flat_steering=scan", "env.robot.scan_columns=0"});
+  EXPECT_NE(e.find("trainer.pilot_flat_steering: scan needs env.robot.scan_columns > 0"), std::string::npos) << e;
+  EXPECT_NE(config_error({"trainer.pilot_flat_steering=lidar"}).find("pilot_flat_steering"), std::string::npos);
+  EXPECT_EQ(config_error({"trainer.pilot_flat_steering=scan", "env.robot.scan_columns=24"}), "");
+}
+
 TEST(Settings, AMissingLearnerSectionIsNamed) {
   const std::string e = error_of([] { coopt_config_from_text("trainer:\n  episodes: 2\n", "bare.yaml"); });
   EXPECT_NE(e.find("bare.yaml: no 'td3:' section: trainer.motion_algo td3 needs the motion model's"),

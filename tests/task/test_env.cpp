@@ -121,6 +121,48 @@ TEST(Env, SpecDeclaresTheObservationsAndTheAction) {
   }
 }
 
+// Steering by the obstacle scan alone (what the motion model sees) must get
+// through the obstacle field: a wrong sign, a wrong ray order or the dithering
+// between two sides it prevents would leave it stuck or hit the boxes.
+TEST(Env, ScanSteeredPilotCrossesTheObstacleField) {
+  task::EnvConfig c;
+  c.robot.scan_columns = 24;
+  task::MultiTaskEnv env(c);
+  task::ScriptedPilot pilot(task::searched_stair_gaits());
+  pilot.params().flat_steering = task::FlatSteering::scan;
+  int successes = 0, collisions = 0;
+  for (int modules : {2, 4})
+    for (std::uint64_t seed = 100; seed < 106; ++seed) {
+      env.reset(spec(seed, modules, 0.04));
+      pilot.plan(env);
+      float a[5];
+      control::MotionMode mode;
+      while (!env.done()) {
+        pilot.act(env, a, mode);
+        env.step(a, mode);
+      }
+      successes += env.last().reason == Termination::success;
+      collisions += env.last().reason == Termination::collision;
+    }
+  EXPECT_GE(successes, 11) << collisions << " collisions";
+}
+
+TEST(Env, ScanSteeringNeedsTheScan) {
+  task::MultiTaskEnv env(task::EnvConfig{});  // scan_columns 0
+  env.reset(spec(1, 2, 0.04));
+  task::ScriptedPilot pilot(task::searched_stair_gaits());  // climbs, so that it reaches the flat area
+  pilot.params().flat_steering = task::FlatSteering::scan;
+  pilot.plan(env);
+  float a[5];
+  control::MotionMode mode;
+  EXPECT_THROW(
+      while (!env.done()) {
+        pilot.act(env, a, mode);
+        env.step(a, mode);
+      },
+      std::logic_error);
+}
+
 TEST(Env, ScriptedRunClimbsReachesTheTargetAndReportsEvents) {
   const task::EnvConfig c;
   task::MultiTaskEnv env(c);

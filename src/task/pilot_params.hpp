@@ -1,0 +1,54 @@
+// The scripted pilot's settings (task::ScriptedPilot): plain data, so that
+// configs can name them without the simulator's headers.
+#pragma once
+
+#include <array>
+#include <optional>
+
+#include "common/enum_names.hpp"
+#include "morphology/configuration.hpp"  // kMaxModules
+
+namespace comorph::task {
+
+struct StairGait {  // stair-mode action (Eq. 4/5 inputs), held while climbing
+  float speed = 1.0f;       // a0
+  float amp_front = 0.0f;   // a2 (-1 = no wave)
+  float phase = 0.5f;       // a3
+  float amp_back = 0.0f;    // a4
+};
+
+// How the pilot steers on the flat area.
+enum class FlatSteering : int { planned = 0, scan = 1 };
+constexpr auto enum_names(FlatSteering) {
+  return std::array{EnumName{FlatSteering::planned, "planned"}, EnumName{FlatSteering::scan, "scan"}};
+}
+
+struct PilotParams {
+  StairGait gait;               // used in stair mode (unless gait_by_modules has one for the chain)
+  // Per chain length (index = modules), a gait of its own where set. One gait
+  // does not suit every length: the wave lag that climbs with 2, 4 or 6
+  // modules stalls 3 modules on the first riser (searched_stair_gaits()).
+  std::array<std::optional<StairGait>, kMaxModules + 1> gait_by_modules{};
+  double heading_gain = 2.5;    // a1 per rad of heading error
+  double lookahead = 0.6;       // m along the planned path
+  double clearance = 0.40;      // m, obstacles inflated by this when planning
+  double slow_turn_error = 0.6; // rad: above this heading error the robot turns before driving
+  FlatSteering flat_steering = FlatSteering::planned;
+  // FlatSteering::scan (needs RobotParams::scan_columns > 0). A bearing is
+  // open when no scanned point lies in the corridor of half-width
+  // scan_corridor_m along it, up to scan_lookahead_m (or the goal). The pilot
+  // aims at the goal when its bearing is open, else at the open ray bearing
+  // nearest the goal. Bearings on the other side than the last turn (the
+  // state's previous action) cost scan_hysteresis_rad more: with an obstacle
+  // straight ahead both sides are equally near the goal while turning in
+  // place, and without it a memoryless controller alternates between them.
+  double scan_corridor_m = 0.4;
+  double scan_lookahead_m = 1.2;
+  double scan_hysteresis_rad = 2.0;
+};
+
+// The pilot with the stair gaits of a search over a0 x a2=a4 x a3 per chain
+// length (docs/results.md): the shared gait, and 3 modules' own.
+PilotParams searched_stair_gaits();
+
+}  // namespace comorph::task
