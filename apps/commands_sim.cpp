@@ -2,8 +2,10 @@
 // robot and its scenario (src/sim, src/control, src/task).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <random>
 #include <stdexcept>
 
 #include "cli_numbers.hpp"
@@ -33,6 +35,8 @@ struct SimOptions {
   int shed_to = 0;
   task::FlatSteering steering = task::FlatSteering::planned;
   int scan_columns = 24;  // the obstacle scan's rays when steering by it (the standard preset's)
+  double noise = 0;       // std of Gaussian noise on the pilot's actions (the trainer's warmup_noise)
+  int max_steps = 0;      // step cap (0: task.yaml's)
 };
 
 task::EnvConfig load_config(const std::string& dir) {
@@ -100,6 +104,7 @@ void run_physics_table(const SimOptions& o) {
 void run_demo(const SimOptions& o) {
   task::EnvConfig c = load_config(o.config_dir);
   if (o.steering == task::FlatSteering::scan && c.robot.scan_columns == 0) c.robot.scan_columns = o.scan_columns;
+  if (o.max_steps > 0) c.task.max_steps = o.max_steps;
   task::MultiTaskEnv env(c);
   task::EpisodeSpec spec;
   spec.seed = o.seed;
@@ -119,6 +124,8 @@ void run_demo(const SimOptions& o) {
   pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};
   pilot.params().flat_steering = o.steering;
   pilot.plan(env);
+  std::mt19937_64 rng(o.seed);
+  std::normal_distribution<float> noise(0.0f, 1.0f);
   float action[control::kActionSize];
   control::MotionMode mode = env.mode(), last_mode = env.mode();
   int last_label = env.scene_label();
@@ -127,6 +134,7 @@ void run_demo(const SimOptions& o) {
                            control::mode_name(mode), last_label);
   while (!env.done()) {
     pilot.act(env, action, mode);
+    for (float& a : action) a = std::clamp(a + float(o.noise) * noise(rng), -1.0f, 1.0f);
     const task::StepResult& r = env.step(action, mode);
     reward_sum += r.reward;
     const double t = env.metrics().time_s;
@@ -211,6 +219,9 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
                    "rays of the obstacle scan with --pilot-steering scan, where the config has none")
       ->capture_default_str()
       ->check(cli::whole_in(1, 1024));
+  demo->add_option("--noise", o.noise, "std of Gaussian noise on the pilot's actions (action units; training uses 0.2)")
+      ->check(cli::finite_in(0, 2));
+  demo->add_option("--max-steps", o.max_steps, "step cap (0 = task.yaml's max_steps)")->check(cli::whole_in(0, 1000000));
   demo->add_option("--config-dir", o.config_dir, cli::kConfigDirHelp);
   demo->callback([] {
     enum_from_name(steering, o.steering);

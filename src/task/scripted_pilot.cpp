@@ -130,7 +130,8 @@ void ScriptedPilot::act(const MultiTaskEnv& env, float a[control::kActionSize],
     a[4] = g.amp_back;
   } else {
     const double turn = std::abs(error);
-    a[0] = float(turn > p_.slow_turn_error ? 0.0 : std::cos(turn) * (1.0 - turn / p_.slow_turn_error * 0.7));
+    const double slow = on_top && p_.flat_steering == FlatSteering::scan ? p_.scan_slow_turn_error : p_.slow_turn_error;
+    a[0] = float(turn > slow ? 0.0 : std::cos(turn) * (1.0 - turn / slow * 0.7));
     a[2] = -1.0f;
     a[3] = 0.0f;
     a[4] = -1.0f;
