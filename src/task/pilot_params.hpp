@@ -39,7 +39,8 @@ struct PilotParams {
   // scan_corridor_m along it, up to scan_lookahead_m (or the goal). The pilot
   // aims at the goal when its bearing is open, else at the open ray bearing
   // nearest the goal. Bearings on the other side than the last turn (the
-  // state's previous action) cost scan_hysteresis_rad more: with an obstacle
+  // state's previous action, when its |a1| exceeds scan_committed_turn) cost
+  // scan_hysteresis_rad more: with an obstacle
   // straight ahead both sides are equally near the goal while turning in
   // place, and without it a memoryless controller alternates between them.
   // Above scan_slow_turn_error of heading error it turns before driving (its
@@ -50,6 +51,7 @@ struct PilotParams {
   double scan_corridor_m = 0.3;
   double scan_lookahead_m = 0.9;
   double scan_hysteresis_rad = 2.0;
+  double scan_committed_turn = 0.2;  // |a1| of the last turn that counts as a side
   double scan_slow_turn_error = 1.0;
 };
 

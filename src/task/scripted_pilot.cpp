@@ -15,6 +15,8 @@ double wrap(double a) {
 }  // namespace
 
 void ScriptedPilot::plan(const MultiTaskEnv& env) {
+  field_.clear();
+  if (p_.flat_steering == FlatSteering::scan) return;  // steers by the scan: no path to plan
   const sim::SceneLayout& s = env.world().layout();
   const sim::SceneParams& sp = env.config().scene;
   x0_ = s.platform_x;
@@ -69,7 +71,8 @@ void ScriptedPilot::act(const MultiTaskEnv& env, float a[control::kActionSize],
   // Steer along the planned path once module 1 is on the flat area (a long
   // chain's head reaches the obstacles while its tail is still climbing).
   const bool on_top = head[0] > env.world().layout().platform_x + 0.3;
-  if (on_top && p_.flat_steering == FlatSteering::scan) {
+  const bool scan_steering = on_top && p_.flat_steering == FlatSteering::scan;
+  if (scan_steering) {
     const sim::SceneLayout& s = env.world().layout();
     const double goal_bearing = wrap(std::atan2(s.target_y - head[1], s.target_x - head[0]) - heading);
     const double bearing = scan_target_bearing(env, goal_bearing, std::hypot(s.target_x - head[0], s.target_y - head[1]));
@@ -130,7 +133,7 @@ void ScriptedPilot::act(const MultiTaskEnv& env, float a[control::kActionSize],
     a[4] = g.amp_back;
   } else {
     const double turn = std::abs(error);
-    const double slow = on_top && p_.flat_steering == FlatSteering::scan ? p_.scan_slow_turn_error : p_.slow_turn_error;
+    const double slow = scan_steering ? p_.scan_slow_turn_error : p_.slow_turn_error;
     a[0] = float(turn > slow ? 0.0 : std::cos(turn) * (1.0 - turn / slow * 0.7));
     a[2] = -1.0f;
     a[3] = 0.0f;
@@ -166,7 +169,8 @@ double ScriptedPilot::scan_target_bearing(const MultiTaskEnv& env, double goal_b
     const double bearing = bearing_of(j);
     if (!open(bearing)) continue;
     double cost = std::abs(bearing - goal_bearing);
-    if (bearing * last_turn < 0 && std::abs(bearing) > step && std::abs(last_turn) > 0.2) cost += p_.scan_hysteresis_rad;
+    if (bearing * last_turn < 0 && std::abs(bearing) > step && std::abs(last_turn) > p_.scan_committed_turn)
+      cost += p_.scan_hysteresis_rad;
     if (cost < best_cost) best_cost = cost, best = bearing;
   }
   if (best_cost < 1e9) return best;
