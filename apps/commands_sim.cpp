@@ -135,7 +135,7 @@ void run_demo(const SimOptions& o) {
   while (!env.done()) {
     pilot.act(env, action, mode);
     for (float& a : action) a = std::clamp(a + float(o.noise) * noise(rng), -1.0f, 1.0f);
-    const task::StepResult& r = env.step(action, mode);
+    const task::StepOutcome& r = env.step(action, mode);
     reward_sum += r.reward;
     const double t = env.metrics().time_s;
     const double* head = env.world().module_pos(0);
@@ -157,7 +157,7 @@ void run_demo(const SimOptions& o) {
       std::cout << fmt::format("  t={:6.2f} s  event: scene label {} -> {}\n", t, last_label, r.scene_label);
     last_label = r.scene_label;
     if (env.step_count() % 100 == 0 || env.done()) {
-      const task::Metrics m = env.metrics();
+      const task::EpisodeMetrics m = env.metrics();
       std::cout << fmt::format(
           "  t={:6.2f} s  step {:4d}  pos ({:5.2f}, {:5.2f}, {:4.2f}) m  to target {:5.2f} m  energy {:7.1f} J "
           "({:4.1f} W per initial module)  R1 sum {:8.1f}\n",
@@ -165,7 +165,7 @@ void run_demo(const SimOptions& o) {
           m.energy_J / std::max(t, 1e-9) / env.initial_modules(), reward_sum);
     }
     if (env.done()) {
-      const task::Metrics m = env.metrics();
+      const task::EpisodeMetrics m = env.metrics();
       std::cout << fmt::format("  t={:6.2f} s  event: {} ({})\n", t,
                                r.reason == task::Termination::success ? "target reached" : "episode ended",
                                task::termination_name(r.reason));

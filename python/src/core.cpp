@@ -75,15 +75,15 @@ void read_action(const py::handle& action, float* out, const std::string& where)
 // Eq. 1's metrics of an ended episode, as the info keys of both envs.
 struct MetricField {
   const char* key;
-  double (*get)(const task::Metrics&);
+  double (*get)(const task::EpisodeMetrics&);
 };
 const MetricField kMetricFields[] = {
-    {"T", [](const task::Metrics& m) { return m.T; }},
-    {"E", [](const task::Metrics& m) { return m.E; }},
-    {"D", [](const task::Metrics& m) { return m.D; }},
-    {"F", [](const task::Metrics& m) { return m.F; }},
-    {"time_s", [](const task::Metrics& m) { return m.time_s; }},
-    {"episode_energy_J", [](const task::Metrics& m) { return m.energy_J; }},
+    {"T", [](const task::EpisodeMetrics& m) { return m.T; }},
+    {"E", [](const task::EpisodeMetrics& m) { return m.E; }},
+    {"D", [](const task::EpisodeMetrics& m) { return m.D; }},
+    {"F", [](const task::EpisodeMetrics& m) { return m.F; }},
+    {"time_s", [](const task::EpisodeMetrics& m) { return m.time_s; }},
+    {"episode_energy_J", [](const task::EpisodeMetrics& m) { return m.energy_J; }},
 };
 constexpr const char* kEpisodeSteps = "episode_steps";
 
@@ -108,7 +108,7 @@ class PyEnv {
   py::tuple step(const py::handle& action) {
     float a[control::kActionSize];
     read_action(action, a, "action");
-    const task::StepResult* r;
+    const task::StepOutcome* r;
     {
       py::gil_scoped_release release;
       r = &core_.step(a);
@@ -176,7 +176,7 @@ class PyEnv {
     info["stair_height"] = e.stair_height();
     info["stairs_climbed"] = e.stairs_climbed();
   }
-  static void metrics_into(const task::Metrics& m, py::dict& d) {
+  static void metrics_into(const task::EpisodeMetrics& m, py::dict& d) {
     for (const MetricField& f : kMetricFields) d[f.key] = f.get(m);
     d[kEpisodeSteps] = m.steps;
   }
@@ -316,7 +316,7 @@ class PyVectorEnv {
       py::gil_scoped_release release;
       for_each_env([&](int i) {
         EnvCore& e = *envs_[i];
-        const task::StepResult& r = e.step(actions_.data() + std::size_t(i) * control::kActionSize);
+        const task::StepOutcome& r = e.step(actions_.data() + std::size_t(i) * control::kActionSize);
         out.reward_p[i] = r.reward;
         out.terminated_p[i] = r.terminated;
         out.truncated_p[i] = r.truncated;
@@ -423,7 +423,7 @@ class PyVectorEnv {
   }
 
   std::vector<std::unique_ptr<EnvCore>> envs_;
-  std::vector<task::Metrics> final_metrics_;  // of the episodes that ended in the last step
+  std::vector<task::EpisodeMetrics> final_metrics_;  // of the episodes that ended in the last step
   std::unique_ptr<Workers> workers_;
   std::vector<float> actions_;
   int depth_size_ = 0, clearance_size_ = 0;
@@ -493,7 +493,7 @@ py::tuple cpp_loop_seconds(const EnvOptions& options, std::uint64_t seed, int st
     const auto start = std::chrono::steady_clock::now();
     const double cpu_start = thread_cpu_seconds();
     for (int i = 0; i < steps; ++i) {
-      const task::StepResult& r = core.step(action.data());
+      const task::StepOutcome& r = core.step(action.data());
       if (r.terminated || r.truncated) core.reset(std::nullopt, 0, 0.0);
     }
     cpu = thread_cpu_seconds() - cpu_start;

@@ -61,7 +61,7 @@ class EnvCore {
     started_ = true;
   }
 
-  const task::StepResult& step(const float* action) {
+  const task::StepOutcome& step(const float* action) {
     require_started("step");
     if (env_.done())
       throw std::runtime_error(std::string("step after the episode ended (") +

@@ -214,7 +214,7 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
 
   // 2. Control steps.
   fill_motion(env, t, b.obs);
-  const task::StepResult* r = nullptr;
+  const task::StepOutcome* r = nullptr;
   std::int64_t saturated = 0;
   while (true) {
     // Also when the pilot drives: the same RNG stream.
@@ -280,7 +280,7 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
     lap(kDqn);
   }
 
-  const task::Metrics m = env.metrics();
+  const task::EpisodeMetrics m = env.metrics();
   log.seed = spec.seed;
   log.scenario = name_of(c.trainer.scenario);
   log.stair_height_m = env.stair_height();

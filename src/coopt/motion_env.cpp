@@ -31,7 +31,7 @@ void MotionEnv::reset(rl::Observation& o) {
 }
 
 rl::StepResult MotionEnv::step(const rl::Action& action, rl::Observation& next) {
-  const task::StepResult& r = env_.step(action.continuous.data(), env_.default_mode());
+  const task::StepOutcome& r = env_.step(action.continuous.data(), env_.default_mode());
   fill_motion(env_.depth(), env_.state(), env_.clearance(), config_.trainer, next);
   return {static_cast<float>(r.reward), r.terminated, r.truncated};
 }

@@ -42,8 +42,8 @@ const std::vector<std::string>& paper_stair_keys() {
 
 std::string stair_key(double stair_height_m) { return fmt::format("{:.2f}", stair_height_m); }
 
-Metrics summarize(const std::vector<EpisodeRecord>& records, const task::ObjectiveWeights& weights) {
-  Metrics m;
+EvalSummary summarize(const std::vector<EpisodeRecord>& records, const task::ObjectiveWeights& weights) {
+  EvalSummary m;
   m.episodes = static_cast<int>(records.size());
   std::map<std::string, std::pair<int, int>> per_height;  // key -> (successes, episodes)
   for (const auto& k : paper_stair_keys()) per_height[k] = {0, 0};
@@ -92,7 +92,7 @@ Metrics summarize(const std::vector<EpisodeRecord>& records, const task::Objecti
   return m;
 }
 
-nlohmann::json to_json(const Metrics& m) {
+nlohmann::json to_json(const EvalSummary& m) {
   nlohmann::json j;
   j["success_rate"] = nlohmann::json::object();
   for (const auto& [k, v] : m.success_rate) j["success_rate"][k] = number_or_null(v);
@@ -109,9 +109,9 @@ nlohmann::json to_json(const Metrics& m) {
   return j;
 }
 
-Metrics metrics_from_json(const nlohmann::json& j, const std::string& where) {
+EvalSummary metrics_from_json(const nlohmann::json& j, const std::string& where) {
   if (!j.is_object()) throw std::runtime_error(fmt::format("{}: not a JSON object", where));
-  Metrics m;
+  EvalSummary m;
   const auto& rates = need(j, "success_rate", where);
   if (!rates.is_object()) throw std::runtime_error(fmt::format("{}: key 'success_rate' is not an object", where));
   for (const auto& k : paper_stair_keys()) need(rates, k, where + " success_rate");
@@ -137,11 +137,11 @@ Metrics metrics_from_json(const nlohmann::json& j, const std::string& where) {
   return m;
 }
 
-void write_metrics_json(const std::string& path, const Metrics& metrics) {
+void write_metrics_json(const std::string& path, const EvalSummary& metrics) {
   write_file_atomic(path, to_json(metrics).dump(2) + "\n");
 }
 
-Metrics read_metrics_json(const std::string& path) {
+EvalSummary read_metrics_json(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(fmt::format("cannot open {}", path));
   nlohmann::json j;

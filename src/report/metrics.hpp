@@ -25,7 +25,8 @@ const std::vector<std::string>& paper_stair_keys();  // {"0.04", "0.06", "0.08"}
 // Summary key of a stair height: metres with two decimals ("0.06").
 std::string stair_key(double stair_height_m);
 
-struct Metrics {
+// What an evaluation measured over its episodes (the eval-<scenario>.json).
+struct EvalSummary {
   int episodes = 0;  // episodes summarised
   // Success fraction (0..1) per stair-height key; always has "0.04", "0.06",
   // "0.08" (NaN when no episode had that height) and any other height seen;
@@ -46,17 +47,17 @@ struct Metrics {
   double shed_after_stairs = 0;
 };
 
-Metrics summarize(const std::vector<EpisodeRecord>& records, const task::ObjectiveWeights& weights = {});
+EvalSummary summarize(const std::vector<EpisodeRecord>& records, const task::ObjectiveWeights& weights = {});
 
 // JSON with exactly the keys success_rate, time_s, energy_J, F, configurations,
 // terminations, episodes, first_modules, shed_after_stairs; NaN is written as
 // null. Reading accepts JSON without the last two (written before they existed).
-nlohmann::json to_json(const Metrics& metrics);
+nlohmann::json to_json(const EvalSummary& metrics);
 // Reads that JSON back (other keys are ignored); throws naming `source` and
 // the key when a key is missing or has the wrong type.
-Metrics metrics_from_json(const nlohmann::json& json, const std::string& source);
+EvalSummary metrics_from_json(const nlohmann::json& json, const std::string& source);
 
-void write_metrics_json(const std::string& path, const Metrics& metrics);
-Metrics read_metrics_json(const std::string& path);
+void write_metrics_json(const std::string& path, const EvalSummary& metrics);
+EvalSummary read_metrics_json(const std::string& path);
 
 }  // namespace comorph::report

@@ -129,7 +129,7 @@ std::string describe(const RunInfo& info) {
 
 ReportBlock comparison_table(const PaperTable& paper, const std::vector<RunDir>& runs) {
   std::vector<std::string> header = {""};
-  std::vector<const Metrics*> ours;
+  std::vector<const EvalSummary*> ours;
   for (const auto& col : paper.columns) {
     const RunDir* run = find_run(runs, col.match);
     header.push_back(run ? fmt::format("{} [{}]", col.label, run->info.name) : col.label);
@@ -144,17 +144,17 @@ ReportBlock comparison_table(const PaperTable& paper, const std::vector<RunDir>&
     }
     rows.push_back(std::move(r));
   };
-  row("Time (s)", [](const Metrics& m) { return num(m.time_s, 1); },
+  row("Time (s)", [](const EvalSummary& m) { return num(m.time_s, 1); },
       [](const PaperColumn& p) { return paper_num(p.time_s); });
-  row("Battery (J)", [](const Metrics& m) { return num(m.energy_J, 0); },
+  row("Battery (J)", [](const EvalSummary& m) { return num(m.energy_J, 0); },
       [](const PaperColumn& p) { return paper_num(p.energy_J); });
   for (const std::string key : {"0.04", "0.06", "0.08", "avg"}) {
     const std::string name = key == "avg" ? "Success avg (%)" : fmt::format("Success {} m (%)", key);
-    row(name, [key](const Metrics& m) { return percent(lookup(m.success_rate, key)); },
+    row(name, [key](const EvalSummary& m) { return percent(lookup(m.success_rate, key)); },
         [key](const PaperColumn& p) { return paper_num(lookup(p.success_percent, key)); });
   }
-  row("F(H)", [](const Metrics& m) { return num(m.F, 3); }, [](const PaperColumn& p) { return paper_num(p.F); });
-  row("Episodes", [](const Metrics& m) { return std::to_string(m.episodes); },
+  row("F(H)", [](const EvalSummary& m) { return num(m.F, 3); }, [](const PaperColumn& p) { return paper_num(p.F); });
+  row("Episodes", [](const EvalSummary& m) { return std::to_string(m.episodes); },
       [](const PaperColumn&) { return std::string("n/a"); });
   return table(std::move(header), std::move(rows));
 }

@@ -35,7 +35,7 @@ struct RunInfo {
 struct RunDir {
   std::string path;
   RunInfo info;
-  std::map<std::string, Metrics> evals;  // test scenario -> its eval-<scenario>.json
+  std::map<std::string, EvalSummary> evals;  // test scenario -> its eval-<scenario>.json
   std::string episodes_csv;              // path of episodes.csv
 };
 

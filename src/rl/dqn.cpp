@@ -1,7 +1,9 @@
 #include "rl/dqn.hpp"
 
 #include <cmath>
+#include <random>
 #include <stdexcept>
+#include <vector>
 
 namespace comorph::rl {
 

@@ -15,8 +15,6 @@
 #include <torch/torch.h>
 
 #include <memory>
-#include <random>
-#include <string>
 #include <vector>
 
 #include "rl/networks.hpp"

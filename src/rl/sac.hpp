@@ -11,9 +11,6 @@
 #include <torch/torch.h>
 
 #include <memory>
-#include <random>
-#include <string>
-#include <vector>
 
 #include "rl/networks.hpp"
 #include "rl/off_policy.hpp"

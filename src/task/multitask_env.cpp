@@ -36,7 +36,7 @@ void MultiTaskEnv::reset(const EpisodeSpec& spec) {
   done_ = false;
   stairs_energy_ = 0;
   prev_action_.fill(0.0f);
-  result_ = StepResult{};
+  result_ = StepOutcome{};
   mode_ = default_mode();
   const double* head = world_.module_pos(0);
   initial_distance_ = std::hypot(layout.target_x - head[0], layout.target_y - head[1]);
@@ -109,7 +109,7 @@ Termination MultiTaskEnv::check_failure(const sim::PhysicsStepInfo& info) const 
   return Termination::none;
 }
 
-const StepResult& MultiTaskEnv::step(const float* action, control::MotionMode mode) {
+const StepOutcome& MultiTaskEnv::step(const float* action, control::MotionMode mode) {
   if (done_) throw std::logic_error("MultiTaskEnv::step after the episode ended; call reset()");
   const int n = world_.modules();
   const double goal_before = goal_distance();
@@ -120,7 +120,7 @@ const StepResult& MultiTaskEnv::step(const float* action, control::MotionMode mo
   ++steps_;
   mode_ = mode;
 
-  StepResult r;
+  StepOutcome r;
   r.energy_J = info.energy_J;
   if (on_stairs_) stairs_energy_ += info.energy_J;
   const double* head = world_.module_pos(0);
@@ -211,8 +211,8 @@ void MultiTaskEnv::update_observation() {
   s[obs::kMode] = float(int(mode_));
 }
 
-Metrics MultiTaskEnv::metrics() const {
-  Metrics m;
+EpisodeMetrics MultiTaskEnv::metrics() const {
+  EpisodeMetrics m;
   m.steps = steps_;
   m.time_s = steps_ * config_.robot.control_period;
   m.energy_J = world_.energy_used();

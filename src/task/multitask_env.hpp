@@ -55,7 +55,7 @@ struct EpisodeSpec {
   sim::Variant variant = sim::Variant::standard;
 };
 
-struct StepResult {
+struct StepOutcome {
   double reward = 0;          // R1 of this step (Eq. 6)
   bool terminated = false;    // success or failure
   bool truncated = false;     // step cap
@@ -67,8 +67,8 @@ struct StepResult {
   double cos_beta = 0;        // heading term of R1
 };
 
-// Metrics of the episode so far (Eq. 1).
-struct Metrics {
+// The objective terms of the episode so far (Eq. 1).
+struct EpisodeMetrics {
   int steps = 0;                 // control steps taken
   double time_s = 0;             // simulated s
   double energy_J = 0;           // J drawn by all modules (shed ones included)
@@ -123,9 +123,9 @@ class MultiTaskEnv {
   // New episode; observations are valid after it.
   void reset(const EpisodeSpec& spec);
   // One control step with the given motion mode. Throws std::logic_error after the episode ended.
-  const StepResult& step(const float* action, control::MotionMode mode);
+  const StepOutcome& step(const float* action, control::MotionMode mode);
   // The same with default_mode() (ground truth) for scripted use.
-  const StepResult& step(const float* action) { return step(action, default_mode()); }
+  const StepOutcome& step(const float* action) { return step(action, default_mode()); }
   // Sheds modules: `part` must be a sub-configuration of configuration()
   // (throws std::invalid_argument naming the fault); carries the kept modules' state exactly.
   void reconfigure(const Configuration& part);
@@ -155,7 +155,7 @@ class MultiTaskEnv {
   int scene_label() const { return label_; }           // sim::SceneLabel of module 1's position
 
   // ---- episode bookkeeping for R2 and evaluation ----
-  Metrics metrics() const;
+  EpisodeMetrics metrics() const;
   bool on_stairs() const { return on_stairs_; }             // some module on the stairs, not yet climbed
   bool stairs_climbed() const { return climbed_step_ >= 0; }
   int stairs_climbed_step() const { return climbed_step_; }  // control step of the r_s event, -1 if not yet
@@ -166,7 +166,7 @@ class MultiTaskEnv {
   int initial_modules() const { return initial_modules_; }
   int step_count() const { return steps_; }
   bool done() const { return done_; }
-  const StepResult& last() const { return result_; }
+  const StepOutcome& last() const { return result_; }
   control::MotionMode mode() const { return mode_; }
   void goal(double& x, double& y) const;                    // current goal (m)
 
@@ -191,7 +191,7 @@ class MultiTaskEnv {
   std::array<float, obs::kStateSize> state_{};
   std::array<float, control::kActionSize> prev_action_{};
   std::array<float, 2 * kMaxModules> distances_{};
-  StepResult result_;
+  StepOutcome result_;
   control::MotionMode mode_ = control::MotionMode::flat;
   int initial_modules_ = 0;
   int steps_ = 0;

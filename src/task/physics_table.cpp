@@ -29,7 +29,7 @@ ClimbTrial run_climb_trial(const EnvConfig& config, int modules, double stair_he
   const int stuck_steps = int(o.stuck_time_s / c.robot.control_period);
   while (!env.done()) {
     pilot.act(env, action, mode);
-    const StepResult& r = env.step(action, control::MotionMode::stair);
+    const StepOutcome& r = env.step(action, control::MotionMode::stair);
     const double progress = env.world().module_pos(modules - 1)[0] - start_tail;
     if (progress > best + 0.01) best = progress, best_step = env.step_count();
     if (r.stairs_climbed_now) {
@@ -39,7 +39,7 @@ ClimbTrial run_climb_trial(const EnvConfig& config, int modules, double stair_he
     if (r.terminated || r.truncated) t.reason = r.reason;
     if (env.step_count() - best_step > stuck_steps) break;
   }
-  const Metrics m = env.metrics();
+  const EpisodeMetrics m = env.metrics();
   t.time_s = m.time_s;
   t.energy_J = m.energy_J;
   t.progress_m = best;

@@ -109,7 +109,7 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
   return finished;
 }
 
-report::Metrics eval_run(const std::string& run_dir, const std::string& scenario, int episodes, int seed,
+report::EvalSummary eval_run(const std::string& run_dir, const std::string& scenario, int episodes, int seed,
                          int workers, int forced_modules) {
   const std::string path = (fs::path(run_dir) / "config.yaml").string();
   if (!fs::exists(path)) throw std::runtime_error(run_dir + ": not a training run (no config.yaml)");

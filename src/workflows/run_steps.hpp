@@ -31,7 +31,7 @@ void clear_run_dir(const std::string& dir);
 // the run config's eval section. forced_modules > 0: the run's motion model
 // drives a fixed chain of that many modules (EvalRequest::forced_modules);
 // the files are then eval-<scenario>-modules<N>.json and -episodes.csv.
-report::Metrics eval_run(const std::string& run_dir, const std::string& scenario, int episodes, int seed,
+report::EvalSummary eval_run(const std::string& run_dir, const std::string& scenario, int episodes, int seed,
                          int workers, int forced_modules = 0);
 
 // Copies what `eval`, `render` and `report` need of a trained run into `out`

@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
   while (!env.done()) {
     for (float& x : a)
       if (std::scanf("%f", &x) != 1) return 0;
-    const task::StepResult& r = env.step(a);
+    const task::StepOutcome& r = env.step(a);
     print_observation(env, r.reward, r.terminated, r.truncated);
   }
   return 0;

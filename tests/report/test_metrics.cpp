@@ -40,7 +40,7 @@ std::vector<EpisodeRecord> hand_log() {
 }
 
 TEST(Metrics, SuccessRatePerHeightAndTheirMean) {
-  const Metrics m = summarize(hand_log());
+  const EvalSummary m = summarize(hand_log());
   EXPECT_EQ(m.episodes, 6);
   EXPECT_DOUBLE_EQ(m.success_rate.at("0.04"), 1.0 / 2.0);
   EXPECT_DOUBLE_EQ(m.success_rate.at("0.06"), 2.0 / 3.0);
@@ -51,7 +51,7 @@ TEST(Metrics, SuccessRatePerHeightAndTheirMean) {
 }
 
 TEST(Metrics, TimeAndEnergyAverageSuccessfulEpisodesOnly) {
-  const Metrics m = summarize(hand_log());
+  const EvalSummary m = summarize(hand_log());
   EXPECT_DOUBLE_EQ(m.time_s, (40.0 + 50.0 + 60.0) / 3.0);
   EXPECT_DOUBLE_EQ(m.energy_J, (3000.0 + 6000.0 + 8000.0) / 3.0);
 }
@@ -81,7 +81,7 @@ TEST(Metrics, ObjectiveFByHand) {
 }
 
 TEST(Metrics, ConfigurationsPerHeightAndTerminations) {
-  const Metrics m = summarize(hand_log());
+  const EvalSummary m = summarize(hand_log());
   EXPECT_EQ(m.configurations.at("0.04").at("2->2"), 1);
   EXPECT_EQ(m.configurations.at("0.04").at("2"), 1);
   EXPECT_EQ(m.configurations.at("0.06").at("4->2"), 2);
@@ -96,7 +96,7 @@ TEST(Metrics, ConfigurationsPerHeightAndTerminations) {
 TEST(Metrics, NoSuccessGivesNullTimeAndEnergy) {
   auto log = hand_log();
   std::vector<EpisodeRecord> failures = {log[1], log[4], log[5]};
-  const Metrics m = summarize(failures);
+  const EvalSummary m = summarize(failures);
   EXPECT_TRUE(std::isnan(m.time_s));
   EXPECT_TRUE(std::isnan(m.energy_J));
   EXPECT_DOUBLE_EQ(m.success_rate.at("avg"), 0.0);
@@ -107,7 +107,7 @@ TEST(Metrics, NoSuccessGivesNullTimeAndEnergy) {
 
 TEST(Metrics, HeightsWithoutEpisodesAreLeftOutOfTheMean) {
   auto log = hand_log();
-  const Metrics m = summarize({log[0], log[1]});  // 0.04 m only
+  const EvalSummary m = summarize({log[0], log[1]});  // 0.04 m only
   EXPECT_TRUE(std::isnan(m.success_rate.at("0.06")));
   EXPECT_DOUBLE_EQ(m.success_rate.at("avg"), 0.5);
   EXPECT_TRUE(to_json(m)["success_rate"]["0.08"].is_null());
@@ -121,19 +121,19 @@ TEST(Metrics, FirstChoicePerHeightAndSheddingAfterTheStairs) {
   log[2].stairs_climbed = true;  // 4 -> 2: shed
   log[3].configurations = {4, 4};
   log[3].stairs_climbed = true;  // kept 4
-  const Metrics m = summarize(log);
+  const EvalSummary m = summarize(log);
   EXPECT_DOUBLE_EQ(m.first_modules.at("0.04"), 2.0);
   EXPECT_DOUBLE_EQ(m.first_modules.at("0.06"), 4.0);
   EXPECT_DOUBLE_EQ(m.first_modules.at("0.08"), 6.0);
   EXPECT_DOUBLE_EQ(m.shed_after_stairs, 2.0 / 3.0);
-  const Metrics back = metrics_from_json(nlohmann::json::parse(to_json(m).dump()), "test");
+  const EvalSummary back = metrics_from_json(nlohmann::json::parse(to_json(m).dump()), "test");
   EXPECT_EQ(back.first_modules, m.first_modules);
   EXPECT_DOUBLE_EQ(back.shed_after_stairs, m.shed_after_stairs);
   EXPECT_TRUE(std::isnan(summarize({hand_log()[1]}).shed_after_stairs));  // nobody climbed
 }
 
 TEST(Metrics, JsonHasExactlyTheAgreedKeysAndReadsBack) {
-  const Metrics m = summarize(hand_log());
+  const EvalSummary m = summarize(hand_log());
   const nlohmann::json j = to_json(m);
   std::vector<std::string> keys;
   for (auto it = j.begin(); it != j.end(); ++it) keys.push_back(it.key());
@@ -143,7 +143,7 @@ TEST(Metrics, JsonHasExactlyTheAgreedKeysAndReadsBack) {
   for (const char* k : {"0.04", "0.06", "0.08", "avg"}) EXPECT_TRUE(j["success_rate"].contains(k)) << k;
   EXPECT_EQ(j["configurations"]["0.06"]["4->2"], 2);
 
-  const Metrics back = metrics_from_json(nlohmann::json::parse(j.dump()), "test");
+  const EvalSummary back = metrics_from_json(nlohmann::json::parse(j.dump()), "test");
   EXPECT_EQ(back.success_rate, m.success_rate);
   EXPECT_DOUBLE_EQ(back.time_s, m.time_s);
   EXPECT_DOUBLE_EQ(back.energy_J, m.energy_J);

@@ -75,7 +75,7 @@ std::vector<EpisodeRecord> fake_episodes(int n, int modules, unsigned seed) {
 struct TinyRuns {
   fs::path root;
   fs::path hier, fixed4;
-  Metrics hier_eval, fixed4_eval, hier_eval7;
+  EvalSummary hier_eval, fixed4_eval, hier_eval7;
 
   TinyRuns() {
     root = fs::temp_directory_path() / fmt::format("comorph-report-test-{}", ::getpid());

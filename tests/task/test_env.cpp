@@ -177,7 +177,7 @@ TEST(Env, ScriptedRunClimbsReachesTheTargetAndReportsEvents) {
   control::MotionMode mode;
   while (!env.done()) {
     pilot.act(env, a, mode);
-    const task::StepResult& r = env.step(a, mode);
+    const task::StepOutcome& r = env.step(a, mode);
     energy += r.energy_J;
     climbed_events += r.stairs_climbed_now;
     if (r.scene_label != labels.back()) labels.push_back(r.scene_label);
@@ -189,7 +189,7 @@ TEST(Env, ScriptedRunClimbsReachesTheTargetAndReportsEvents) {
   EXPECT_GT(env.stairs_energy(), 0.0);
   EXPECT_LT(env.stairs_energy(), energy);
   EXPECT_EQ(labels, (std::vector<int>{0, 1, 2}));
-  const task::Metrics m = env.metrics();
+  const task::EpisodeMetrics m = env.metrics();
   EXPECT_NEAR(m.energy_J, energy, 1e-6);
   EXPECT_NEAR(m.E, energy / 20000.0, 1e-12);
   EXPECT_GT(m.D, 0.9);
@@ -213,7 +213,7 @@ TEST(Env, FailureStatesEndTheEpisodeWithTheirReason) {
   mjData* d = env.mutable_world().mutable_data();
   d->qpos[1] = 1.2;
   mj_forward(env.world().model(), d);
-  const task::StepResult& left = env.step(forward, control::MotionMode::flat);
+  const task::StepOutcome& left = env.step(forward, control::MotionMode::flat);
   EXPECT_TRUE(left.terminated);
   EXPECT_EQ(left.reason, Termination::left_area);
   EXPECT_LT(left.reward, -5.0);  // r_u
@@ -254,7 +254,7 @@ TEST(Env, FailureStatesEndTheEpisodeWithTheirReason) {
   capped.reset(spec(3, 2));
   const float still[5] = {0.0f, 0.0f, -1.0f, 0.0f, -1.0f};
   for (int t = 0; t < 4; ++t) EXPECT_FALSE(capped.step(still).truncated);
-  const task::StepResult& r = capped.step(still);
+  const task::StepOutcome& r = capped.step(still);
   EXPECT_TRUE(r.truncated);
   EXPECT_FALSE(r.terminated);
   EXPECT_EQ(r.reason, Termination::step_cap);
