@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   rl::set_torch_threads(threads, 1);
 
-  fmt::print("torch {} intra-op thread(s), {} inter-op; batch {}, 256-wide MLPs, image 1x{}x{}, "
+  fmt::print("torch {} intra-op thread(s), {} inter-op; batch {}, MLPs 256 wide unless named, image 1x{}x{}, "
              "vector {}, action {}\n",
              at::get_num_threads(), at::get_num_interop_threads(), batch, image_size, image_size,
              vector_size, action_dims);
@@ -113,11 +113,12 @@ int main(int argc, char** argv) {
   const rl::ObservationSpec img_spec{1, image_size, image_size, vector_size};
   const rl::ActionSpec cont{rl::ActionKind::kContinuous, action_dims};
 
-  // TD3 (vector observation).
-  {
+  // TD3 (vector observation) at three widths: the smaller the networks, the
+  // larger the share of per-operation overhead (ratio) in an update.
+  for (int width : {64, 128, 256}) {
     rl::Td3Config c;
     c.batch_size = batch;
-    c.hidden_sizes = {256, 256};
+    c.hidden_sizes = {width, width};
     rl::Td3 td3(vec_spec, action_dims, c, 1);
     fill(td3, vec_spec, cont, 2000);
     const double Fa = td3.networks()->actor->forward_flops();
@@ -125,7 +126,8 @@ int main(int argc, char** argv) {
     // target actor + 2 target critics; 2 critics fwd+bwd; actor step (actor fwd+bwd,
     // critic fwd+bwd) every policy_delay updates.
     const double flops = batch * (Fa + 2 * Fc + 6 * Fc + (3 * Fa + 3 * Fc) / c.policy_delay);
-    print_row({"TD3 update (vector obs)", seconds_per_call([&] { td3.update(); }, min_seconds), flops},
+    print_row({fmt::format("TD3 update (vector obs), {} wide", width),
+               seconds_per_call([&] { td3.update(); }, min_seconds), flops},
               s_per_flop);
   }
   // SAC (vector observation).
