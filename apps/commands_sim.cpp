@@ -34,6 +34,7 @@ struct SimOptions {
   bool quick = false;
   int shed_to = 0;
   task::FlatSteering steering = task::FlatSteering::planned;
+  task::StairSteering stair_steering = task::StairSteering::straight;
   int scan_columns = 24;  // the obstacle scan's rays when steering by it (the standard preset's)
   double noise = 0;       // std of Gaussian noise on the pilot's actions (the trainer's warmup_noise)
   int max_steps = 0;      // step cap (0: task.yaml's)
@@ -103,7 +104,8 @@ void run_physics_table(const SimOptions& o) {
 
 void run_demo(const SimOptions& o) {
   task::EnvConfig c = load_config(o.config_dir);
-  if (o.steering == task::FlatSteering::scan && c.robot.scan_columns == 0) c.robot.scan_columns = o.scan_columns;
+  const bool scans = o.steering == task::FlatSteering::scan || o.stair_steering == task::StairSteering::scan;
+  if (scans && c.robot.scan_columns == 0) c.robot.scan_columns = o.scan_columns;
   if (o.max_steps > 0) c.task.max_steps = o.max_steps;
   task::MultiTaskEnv env(c);
   task::EpisodeSpec spec;
@@ -123,6 +125,7 @@ void run_demo(const SimOptions& o) {
   // The stair gait the physics-table search picks (full amplitude, wave lag -0.5).
   pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};
   pilot.params().flat_steering = o.steering;
+  pilot.params().stair_steering = o.stair_steering;
   pilot.plan(env);
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<float> noise(0.0f, 1.0f);
@@ -215,16 +218,25 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
         task::FlatSteering s;
         return enum_from_name(v, s) ? std::string() : "not one of " + enum_name_list<task::FlatSteering>();
       });
+  static std::string stair_steering = "straight";
+  demo->add_option("--pilot-stair-steering", stair_steering,
+                   "stairs: " + enum_name_list<task::StairSteering>() +
+                       " (up the middle | around the obstacles the scan shows on the treads)")
+      ->check([](const std::string& v) {
+        task::StairSteering s;
+        return enum_from_name(v, s) ? std::string() : "not one of " + enum_name_list<task::StairSteering>();
+      });
   demo->add_option("--scan-columns", o.scan_columns,
-                   "rays of the obstacle scan with --pilot-steering scan, where the config has none")
+                   "rays of the obstacle scan when the pilot steers by it, where the config has none")
       ->capture_default_str()
-      ->check(cli::whole_in(1, 1024));
+      ->check(cli::whole_in(1, 256));
   demo->add_option("--noise", o.noise, "std of Gaussian noise on the pilot's actions (action units; training uses 0.2)")
       ->check(cli::finite_in(0, 2));
   demo->add_option("--max-steps", o.max_steps, "step cap (0 = task.yaml's max_steps)")->check(cli::whole_in(0, 1000000));
   demo->add_option("--config-dir", o.config_dir, cli::kConfigDirHelp);
   demo->callback([] {
     enum_from_name(steering, o.steering);
+    enum_from_name(stair_steering, o.stair_steering);
     run_demo(o);
   });
 }};

@@ -90,6 +90,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   f.add(pre + ".pilot_random_configs", &p.pilot_random_configs);
   f.add(pre + ".pilot_gait_per_modules", &p.pilot_gait_per_modules);
   f.add(pre + ".pilot_flat_steering", &p.pilot_flat_steering);
+  f.add(pre + ".pilot_stair_steering", &p.pilot_stair_steering);
   f.add(pre + ".pilot_labels", &p.pilot_labels);
   f.add(pre + ".greedy_motion_interval", &p.greedy_motion_interval, 0, 10000000);
   f.add(pre + ".config_learns_from", &p.config_learns_from);
@@ -179,6 +180,8 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
     throw std::runtime_error(src + ": perception.classifier.image_size must equal env.robot.depth_width");
   if (c.trainer.pilot_flat_steering == task::FlatSteering::scan && c.env.robot.scan_columns < 1)
     throw std::runtime_error(src + ": trainer.pilot_flat_steering: scan needs env.robot.scan_columns > 0 (the obstacle scan)");
+  if (c.trainer.pilot_stair_steering == task::StairSteering::scan && c.env.robot.scan_columns < 1)
+    throw std::runtime_error(src + ": trainer.pilot_stair_steering: scan needs env.robot.scan_columns > 0 (the obstacle scan)");
   if (c.env.robot.depth_width != c.env.robot.depth_height)
     throw std::runtime_error(src + ": env.robot: depth images must be square for the CNN encoders");
 

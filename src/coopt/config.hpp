@@ -93,6 +93,10 @@ struct TrainerParams {
   // model sees, so the model can follow them; planned labels differ between
   // states the model cannot tell apart, and it dithered in front of obstacles).
   task::FlatSteering pilot_flat_steering = task::FlatSteering::planned;
+  // How the pilot steers while climbing (task::StairSteering): straight (up
+  // the middle) | scan (around the obstacles the scan shows on the treads:
+  // the mixed scenario; short chains turn in stair mode, 5 and more barely).
+  task::StairSteering pilot_stair_steering = task::StairSteering::straight;
   // Every this-many-th episode after the warm-up that the motion model drives
   // is played without its exploration noise (its transitions still train it); 0 = none.
   int greedy_motion_interval = 0;

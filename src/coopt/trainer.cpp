@@ -33,6 +33,7 @@ Trainer::Impl::Impl(const CooptConfig& c, const std::string& dir, TrainerCallbac
   else
     pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};  // the gait the physics-table search picks
   pilot.params().flat_steering = c.trainer.pilot_flat_steering;
+  pilot.params().stair_steering = c.trainer.pilot_stair_steering;
 }
 
 double Trainer::Impl::wall() const {

@@ -23,6 +23,13 @@ constexpr auto enum_names(FlatSteering) {
   return std::array{EnumName{FlatSteering::planned, "planned"}, EnumName{FlatSteering::scan, "scan"}};
 }
 
+// How the pilot steers while climbing: straight up the middle of the stairs,
+// or around what the obstacle scan shows on the treads (the mixed variant).
+enum class StairSteering : int { straight = 0, scan = 1 };
+constexpr auto enum_names(StairSteering) {
+  return std::array{EnumName{StairSteering::straight, "straight"}, EnumName{StairSteering::scan, "scan"}};
+}
+
 struct PilotParams {
   StairGait gait;               // used in stair mode (unless gait_by_modules has one for the chain)
   // Per chain length (index = modules), a gait of its own where set. One gait
@@ -53,6 +60,21 @@ struct PilotParams {
   double scan_hysteresis_rad = 2.0;
   double scan_committed_turn = 0.2;  // |a1| of the last turn that counts as a side
   double scan_slow_turn_error = 1.0;
+  // StairSteering::scan (needs the scan too). Climbing, the level scan also
+  // hits the risers (a wall across the whole fan, or its rays one by one, 0.1 m
+  // apart and more) and, when the module pitches down, the tread ahead. An
+  // obstacle is a run of at least 2 adjacent rays whose points lie within
+  // stair_point_gap_m of each other and span at most stair_obstacle_max_m
+  // (a 0.3 m box: 0.2 to 0.3 m; a riser's run spans 0.6 m and more). The
+  // pilot keeps its lane (drives along the stairs) unless such a run lies in
+  // the corridor ahead up to stair_lookahead_m; then it aims at the open
+  // bearing nearest the stairs' direction, as on the flat area. It returns to
+  // the middle only beyond stair_lane_m from it.
+  StairSteering stair_steering = StairSteering::straight;
+  double stair_point_gap_m = 0.12;
+  double stair_obstacle_max_m = 0.45;
+  double stair_lookahead_m = 1.0;
+  double stair_lane_m = 0.5;
 };
 
 // The pilot with the stair gaits of a search over a0 x a2=a4 x a3 per chain

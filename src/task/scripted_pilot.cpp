@@ -1,12 +1,15 @@
 #include "task/scripted_pilot.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <queue>
 #include <stdexcept>
 
 namespace comorph::task {
 namespace {
+constexpr std::size_t kMaxScanRays = 256;  // RobotParams::scan_columns' upper bound (params_yaml)
+
 double wrap(double a) {
   while (a > M_PI) a -= 2 * M_PI;
   while (a < -M_PI) a += 2 * M_PI;
@@ -118,7 +121,14 @@ void ScriptedPilot::act(const MultiTaskEnv& env, float a[control::kActionSize],
       gy = env.world().layout().target_y;
     }
   }
-  if (!on_top) {  // straight up the middle of the stairs
+  if (!on_top && p_.stair_steering == StairSteering::scan) {
+    // Along the stairs in its lane (back towards the middle beyond
+    // stair_lane_m), around an obstacle the scan shows ahead.
+    const double lane_y = std::clamp(head[1], -p_.stair_lane_m, p_.stair_lane_m);
+    const double bearing = stair_target_bearing(env, wrap(std::atan2(lane_y - head[1], 1.0) - heading));
+    gx = head[0] + std::cos(heading + bearing);
+    gy = head[1] + std::sin(heading + bearing);
+  } else if (!on_top) {  // straight up the middle of the stairs
     gx = head[0] + 1.0;
     gy = 0.0;
   }
@@ -143,26 +153,63 @@ void ScriptedPilot::act(const MultiTaskEnv& env, float a[control::kActionSize],
 
 double ScriptedPilot::scan_target_bearing(const MultiTaskEnv& env, double goal_bearing, double goal_distance) const {
   const sim::RobotParams& robot = env.config().robot;
-  const int rays = env.clearance_width();
   if (robot.scan_columns <= 0)
     throw std::logic_error("ScriptedPilot: flat_steering scan needs env.robot.scan_columns > 0");
+  // The goal outside the fan: turn towards it (nothing is known there).
+  if (std::abs(goal_bearing) > 0.5 * robot.scan_fov_x) return goal_bearing;
+  std::array<bool, kMaxScanRays> every;
+  every.fill(true);
+  return open_bearing(env, every.data(), goal_bearing, std::min(p_.scan_lookahead_m, goal_distance));
+}
+
+double ScriptedPilot::stair_target_bearing(const MultiTaskEnv& env, double goal_bearing) const {
+  const sim::RobotParams& robot = env.config().robot;
+  if (robot.scan_columns <= 0)
+    throw std::logic_error("ScriptedPilot: stair_steering scan needs env.robot.scan_columns > 0");
+  const int rays = env.clearance_width();
+  if (rays > int(kMaxScanRays)) throw std::logic_error("ScriptedPilot: more than 256 scan rays");
+  const double fov = robot.scan_fov_x, step = fov / rays;
+  const float* scan = env.clearance();
+  auto x_of = [&](int j) { return scan[j] * robot.depth_max_range * std::cos(0.5 * fov - step * (j + 0.5)); };
+  auto y_of = [&](int j) { return scan[j] * robot.depth_max_range * std::sin(0.5 * fov - step * (j + 0.5)); };
+  // Runs of adjacent hits whose points are within stair_point_gap_m of the
+  // previous one; a run of 2+ rays spanning at most stair_obstacle_max_m counts.
+  std::array<bool, kMaxScanRays> obstacle;
+  obstacle.fill(false);
+  int start = -1;
+  for (int j = 0; j <= rays; ++j) {
+    const bool joins = j < rays && scan[j] < 1.0f && start >= 0 &&
+                       std::hypot(x_of(j) - x_of(j - 1), y_of(j) - y_of(j - 1)) <= p_.stair_point_gap_m;
+    if (joins) continue;
+    if (start >= 0 && j - start >= 2 &&
+        std::hypot(x_of(j - 1) - x_of(start), y_of(j - 1) - y_of(start)) <= p_.stair_obstacle_max_m)
+      for (int k = start; k < j; ++k) obstacle[std::size_t(k)] = true;
+    start = j < rays && scan[j] < 1.0f ? j : -1;
+  }
+  if (std::abs(goal_bearing) > 0.5 * fov) return goal_bearing;
+  return open_bearing(env, obstacle.data(), goal_bearing, p_.stair_lookahead_m);
+}
+
+double ScriptedPilot::open_bearing(const MultiTaskEnv& env, const bool* counts, double goal_bearing,
+                                   double lookahead) const {
+  const sim::RobotParams& robot = env.config().robot;
+  const int rays = env.clearance_width();
+  if (rays > int(kMaxScanRays)) throw std::logic_error("ScriptedPilot: more than 256 scan rays");
   const double fov = robot.scan_fov_x, step = fov / rays;
   const float* scan = env.clearance();  // fraction of depth_max_range, ray 0 at the left
   const double last_turn = env.state()[obs::kPrevAction + 1];
-  const double lookahead = std::min(p_.scan_lookahead_m, goal_distance);
   auto bearing_of = [&](int j) { return 0.5 * fov - step * (j + 0.5); };
-  // Open: no scanned point in the corridor of half-width scan_corridor_m
-  // ahead along the bearing, up to the lookahead.
+  // Open: no counted scanned point in the corridor of half-width
+  // scan_corridor_m ahead along the bearing, up to the lookahead.
   auto open = [&](double bearing) {
     for (int k = 0; k < rays; ++k) {
+      if (!counts[k]) continue;
       const double r = scan[k] * robot.depth_max_range, d = bearing_of(k) - bearing;
       const double along = r * std::cos(d), across = std::abs(r * std::sin(d));
       if (scan[k] < 1.0f && along > 0 && along < lookahead && across < p_.scan_corridor_m) return false;
     }
     return true;
   };
-  // The goal outside the fan: turn towards it (nothing is known there).
-  if (std::abs(goal_bearing) > 0.5 * fov) return goal_bearing;
   if (open(goal_bearing)) return goal_bearing;
   double best = 0, best_cost = 1e9;
   for (int j = 0; j < rays; ++j) {

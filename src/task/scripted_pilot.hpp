@@ -29,6 +29,11 @@ class ScriptedPilot {
   // Bearing (rad, + left of module 1's heading) to aim at on the flat area
   // from the obstacle scan, given the goal's bearing and distance.
   double scan_target_bearing(const MultiTaskEnv& env, double goal_bearing, double goal_distance) const;
+  // The same on the stairs, where only runs of rays shaped like an obstacle
+  // count (PilotParams::stair_steering); the goal is the stairs' direction.
+  double stair_target_bearing(const MultiTaskEnv& env, double goal_bearing) const;
+  // Bearing to aim at among the scan's rays for which `counts` is true.
+  double open_bearing(const MultiTaskEnv& env, const bool* counts, double goal_bearing, double lookahead) const;
 
   PilotParams p_;
   // Distance-to-target field on a grid over the flat area (m; < 0 blocked).

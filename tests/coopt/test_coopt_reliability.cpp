@@ -255,6 +255,10 @@ TEST(Settings, ScanSteeringWithoutTheScanIsRefused) {
   EXPECT_NE(e.find("trainer.pilot_flat_steering: scan needs env.robot.scan_columns > 0"), std::string::npos) << e;
   EXPECT_NE(config_error({"trainer.pilot_flat_steering=lidar"}).find("pilot_flat_steering"), std::string::npos);
   EXPECT_EQ(config_error({"trainer.pilot_flat_steering=scan", "env.robot.scan_columns=24"}), "");
+  const std::string stairs = config_error({"trainer.pilot_stair_steering=scan", "env.robot.scan_columns=0"});
+  EXPECT_NE(stairs.find("trainer.pilot_stair_steering: scan needs env.robot.scan_columns > 0"), std::string::npos)
+      << stairs;
+  EXPECT_NE(config_error({"trainer.pilot_stair_steering=sideways"}).find("pilot_stair_steering"), std::string::npos);
 }
 
 TEST(Settings, AMissingLearnerSectionIsNamed) {
