@@ -19,6 +19,7 @@
 #include <random>
 
 #include "rl/dqn.hpp"
+#include "rl/flat_adam.hpp"
 #include "rl/learner.hpp"
 #include "rl/sac.hpp"
 #include "rl/td3.hpp"
@@ -191,6 +192,44 @@ int main(int argc, char** argv) {
     print_row({"paper DQN update (image only, batch 64)",
                seconds_per_call([&] { dqn.update(); }, min_seconds), 64 * 4.0 * probe->forward_flops()},
               s_per_flop);
+  }
+
+  // What the flat buffers buy (rl/flat_adam.hpp): the optimizer-side steps of
+  // one update over a 64-wide TD3's critic parameters, per tensor as torch
+  // does them against one operation over the flat buffer, measured together.
+  {
+    const auto critic_net = [&] {
+      return rl::ActorCritic(vec_spec, action_dims, action_dims, std::vector<int>{64, 64}, 16, 256, true);
+    };
+    rl::ActorCritic per_tensor = critic_net(), flat = critic_net(), per_tensor_target = critic_net(),
+                    flat_target = critic_net();
+    const torch::Tensor x = torch::rand({batch, vector_size + action_dims});
+    const auto backward = [&](rl::ActorCritic& n) { n->critic1->forward(x).sum().add(n->critic2->forward(x).sum()).backward(); };
+    torch::optim::Adam torch_adam(per_tensor->critic_parameters(), torch::optim::AdamOptions(1e-3));
+    rl::FlatAdam flat_adam(flat->critic_parameters(), {});
+    rl::FlatParameters flat_target_params(flat_target->critic_parameters(), false);
+    backward(per_tensor);
+    backward(flat);
+    const auto tensors = per_tensor->critic_parameters();
+    fmt::print("\n{:<46} {:>13} {:>13} {:>7}\n",
+               fmt::format("64-wide TD3 critics, {} tensors", tensors.size()), "per tensor", "flat", "ratio");
+    const auto row = [&](const std::string& name, const std::function<void()>& a, const std::function<void()>& b) {
+      const double ta = seconds_per_call(a, min_seconds / 2), tb = seconds_per_call(b, min_seconds / 2);
+      fmt::print("{:<46} {:>10.1f} us {:>10.1f} us {:>7.2f}\n", name, 1e6 * ta, 1e6 * tb, ta / tb);
+    };
+    row("Adam step", [&] { torch_adam.step(); }, [&] { flat_adam.step(); });
+    row("zero_grad + clip_grad_norm", [&] {
+      torch_adam.zero_grad();
+      torch::nn::utils::clip_grad_norm_(tensors, 1.0);
+    }, [&] {
+      flat_adam.zero_grad();
+      flat_adam.clip_grad_norm(1.0);
+    });
+    row("Polyak step of the target", [&] {
+      torch::NoGradGuard no_grad;
+      const auto d = per_tensor_target->critic_parameters();
+      for (std::size_t i = 0; i < d.size(); ++i) d[i].mul_(0.995).add_(tensors[i], 0.005);
+    }, [&] { rl::soft_update(flat_target_params, flat_adam.parameters(), 0.005); });
   }
 
   // Acting latency at batch 1 (InferenceMode inside act()).

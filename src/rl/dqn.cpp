@@ -1,5 +1,6 @@
 #include "rl/dqn.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -61,8 +62,8 @@ Dqn::Dqn(const ObservationSpec& observation, int num_actions, const DqnConfig& c
     : OffPolicyLearner("dqn", "q", observation, {ActionKind::kDiscrete, num_actions}, config, seed),
       num_actions_(num_actions), config_(config) {
   build_networks(seed, q_, q_target_, [&] { return make_network(spec_, num_actions, config); });
-  optimizer_ = std::make_unique<torch::optim::Adam>(
-      q_->parameters(), torch::optim::AdamOptions(config.learning_rate).eps(config.adam_epsilon));
+  optimizer_ = make_adam(q_->parameters(), config.learning_rate, config.adam_epsilon);
+  target_ = FlatParameters(q_target_->parameters(), /*with_grad=*/false);
 }
 
 double Dqn::epsilon() const { return epsilon_at(config_, counters_); }
@@ -102,13 +103,12 @@ void Dqn::update() {
   last_loss_ = loss.item<double>();
   ++counters_.updates;
   if (counters_.updates % config_.target_update_interval == 0) {
-    if (config_.tau >= 1.0) copy_parameters(*q_target_, *q_);
-    else soft_update(*q_target_, *q_, config_.tau);
+    soft_update(target_, optimizer_->parameters(), std::min(config_.tau, 1.0));
   }
 }
 
 Dqn::CheckpointParts Dqn::checkpoint_parts() const {
-  return {{{"q", q_.ptr().get()}, {"q_target", q_target_.ptr().get()}}, {{"optimizer", optimizer_.get()}}};
+  return {{{"q", q_.ptr().get()}, {"q_target", q_target_.ptr().get()}}, {{"optimizer", optimizer_.get()}}, {&target_}};
 }
 
 std::unique_ptr<Policy> Dqn::policy(const ObservationSpec& observation, int num_actions, const DqnConfig& config,

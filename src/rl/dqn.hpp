@@ -53,7 +53,8 @@ class Dqn final : public OffPolicyLearner {
   int num_actions_;
   DqnConfig config_;
   QNetwork q_{nullptr}, q_target_{nullptr};
-  std::unique_ptr<torch::optim::Adam> optimizer_;
+  std::unique_ptr<FlatAdam> optimizer_;  // over q_'s parameters
+  mutable FlatParameters target_;        // q_target_'s, laid out as optimizer_'s
 };
 
 }  // namespace comorph::rl

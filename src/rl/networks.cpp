@@ -108,14 +108,6 @@ void copy_parameters(torch::nn::Module& dst, const torch::nn::Module& src) {
   for (std::size_t i = 0; i < d.size(); ++i) d[i].copy_(s[i]);
 }
 
-void soft_update(torch::nn::Module& dst, const torch::nn::Module& src, double tau) {
-  torch::NoGradGuard no_grad;
-  auto d = dst.parameters();
-  const auto s = src.parameters();
-  if (d.size() != s.size()) throw std::logic_error("soft_update: architectures differ");
-  for (std::size_t i = 0; i < d.size(); ++i) d[i].mul_(1.0 - tau).add_(s[i], tau);
-}
-
 torch::Tensor image_batch(const Observation& o, const ObservationSpec& spec,
                           const torch::Device& device) {
   if (!spec.has_image()) return {};

@@ -13,8 +13,9 @@
 //   (the CnnEncoder whose last FC has n outputs).
 //
 // Target networks are built as a second instance of the same architecture and
-// kept in step with copy_parameters / soft_update (parameters in registration
-// order), which avoids Cloneable boilerplate.
+// started with copy_parameters (parameters in registration order), which
+// avoids Cloneable boilerplate; the learners then average them in with one
+// soft_update over flat buffers (rl/flat_adam.hpp).
 #pragma once
 
 #include <torch/torch.h>
@@ -112,8 +113,6 @@ TORCH_MODULE(ActorCritic);
 
 // dst <- src, parameter by parameter (same architecture).
 void copy_parameters(torch::nn::Module& dst, const torch::nn::Module& src);
-// dst <- tau * src + (1 - tau) * dst (Polyak averaging of target networks).
-void soft_update(torch::nn::Module& dst, const torch::nn::Module& src, double tau);
 
 // A batch of one observation as tensors on `device` ([1, C, H, W] and [1, V];
 // undefined where the spec has none).

@@ -16,14 +16,14 @@ torch::Tensor gaussian_noise(std::int64_t rows, std::int64_t cols, double std, s
   return noise.to(device);
 }
 
-void gradient_step(torch::optim::Optimizer& optimizer, const torch::Tensor& loss, double max_grad_norm) {
+void gradient_step(FlatAdam& optimizer, const torch::Tensor& loss, double max_grad_norm) {
   optimizer.zero_grad();
   loss.backward();
-  if (max_grad_norm > 0) torch::nn::utils::clip_grad_norm_(optimizer.param_groups()[0].params(), max_grad_norm);
+  if (max_grad_norm > 0) optimizer.clip_grad_norm(max_grad_norm);
   optimizer.step();
 }
 
-torch::Tensor twin_critic_step(ActorCritic& nets, torch::optim::Optimizer& optimizer, const ReplayBatch& b,
+torch::Tensor twin_critic_step(ActorCritic& nets, FlatAdam& optimizer, const ReplayBatch& b,
                                const torch::Tensor& y, double max_grad_norm, double& loss) {
   const torch::Tensor f = nets->critic_features(b.image, b.vector);
   const torch::Tensor critic_loss = torch::mse_loss(nets->q1(f, b.action), y) + torch::mse_loss(nets->q2(f, b.action), y);
@@ -92,8 +92,15 @@ void OffPolicyLearner::load(const std::string& path) {
   torch::serialize::InputArchive a;
   a.load_from(path, device_);
   read_common(a, counters_, rng_, algorithm_);
-  if (read_policy_only(a, key_, acting_module())) return;
   const CheckpointParts parts = checkpoint_parts();
+  const auto rebind = [&] {
+    for (const auto& [key, optimizer] : parts.optimizers) optimizer->rebind();
+    for (FlatParameters* f : parts.flat) f->rebind();
+  };
+  if (read_policy_only(a, key_, acting_module())) {
+    rebind();
+    return;
+  }
   for (const auto& [key, module] : parts.modules) {
     torch::serialize::InputArchive part;
     a.read(key, part);
@@ -105,6 +112,7 @@ void OffPolicyLearner::load(const std::string& path) {
     a.read(key, part);
     optimizer->load(part);
   }
+  rebind();
   read_replay(a, replay_);
 }
 

@@ -7,11 +7,13 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <random>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "rl/flat_adam.hpp"
 #include "rl/learner.hpp"
 #include "rl/networks.hpp"
 #include "rl/replay_buffer.hpp"
@@ -51,13 +53,13 @@ bool act_continuous(const Config& c, int action_dims, const LearnerCounters& cou
 
 // One gradient step: zero_grad, backward, the gradient's L2 norm clipped to
 // max_grad_norm (0: not clipped), step; over the optimizer's own parameters.
-void gradient_step(torch::optim::Optimizer& optimizer, const torch::Tensor& loss, double max_grad_norm);
+void gradient_step(FlatAdam& optimizer, const torch::Tensor& loss, double max_grad_norm);
 
 // The twin critics' step of TD3 and SAC towards the targets y: MSE of Q1 and
 // Q2 at the batch's actions, one gradient_step. The critic encoder runs once
 // for both; its features of the batch are returned (the actor step reuses
 // them, detached) with the loss in `loss`.
-torch::Tensor twin_critic_step(ActorCritic& nets, torch::optim::Optimizer& optimizer, const ReplayBatch& b,
+torch::Tensor twin_critic_step(ActorCritic& nets, FlatAdam& optimizer, const ReplayBatch& b,
                                const torch::Tensor& y, double max_grad_norm, double& loss);
 
 // The actor's features of one observation (TD3, SAC acting; the caller holds
@@ -116,15 +118,26 @@ class OffPolicyLearner : public Learner {
 
   // The acting networks (a module holder: const access still loads into them).
   virtual torch::nn::Module& acting_module() const = 0;
+  // Adam with this learner's options over `parameters`, kept flat (rl/flat_adam.hpp).
+  static std::unique_ptr<FlatAdam> make_adam(std::vector<torch::Tensor> parameters, double learning_rate,
+                                             double epsilon = 1e-8) {
+    FlatAdam::Options o;
+    o.learning_rate = learning_rate;
+    o.epsilon = epsilon;
+    return std::make_unique<FlatAdam>(std::move(parameters), o);
+  }
   // The exponent k of a stored transition's discount gamma^k, for one that
   // lasted `steps` environment steps (DQN's discount_per: decision gives 1).
   virtual int discount_steps(int steps) const { return steps; }
   // The algorithm's part of a full checkpoint, between the counters and the
   // replay: its networks (online and target) and optimizers, each under its
   // archive key, and anything else it learns (write_extra / read_extra).
+  // `flat`: the target networks' flat buffers, rebound with the optimizers'
+  // after a load (a module load gives parameters new storage).
   struct CheckpointParts {
     std::vector<std::pair<std::string, torch::nn::Module*>> modules;
-    std::vector<std::pair<std::string, torch::optim::Optimizer*>> optimizers;
+    std::vector<std::pair<std::string, FlatAdam*>> optimizers;
+    std::vector<FlatParameters*> flat;
   };
   virtual CheckpointParts checkpoint_parts() const = 0;
   virtual void write_extra(torch::serialize::OutputArchive&) const {}

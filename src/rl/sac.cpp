@@ -54,12 +54,10 @@ Sac::Sac(const ObservationSpec& observation, int action_dims, const SacConfig& c
   log_alpha_ = torch::full({1}, std::log(config.alpha),
                            torch::TensorOptions().dtype(torch::kFloat32).device(device_))
                    .set_requires_grad(true);
-  actor_optimizer_ = std::make_unique<torch::optim::Adam>(
-      nets_->actor_parameters(), torch::optim::AdamOptions(config.actor_learning_rate));
-  critic_optimizer_ = std::make_unique<torch::optim::Adam>(
-      nets_->critic_parameters(), torch::optim::AdamOptions(config.critic_learning_rate));
-  alpha_optimizer_ = std::make_unique<torch::optim::Adam>(
-      std::vector<torch::Tensor>{log_alpha_}, torch::optim::AdamOptions(config.alpha_learning_rate));
+  actor_optimizer_ = make_adam(nets_->actor_parameters(), config.actor_learning_rate);
+  critic_optimizer_ = make_adam(nets_->critic_parameters(), config.critic_learning_rate);
+  alpha_optimizer_ = make_adam({log_alpha_}, config.alpha_learning_rate);
+  target_critic_ = FlatParameters(target_->critic_parameters(), /*with_grad=*/false);
 }
 
 double Sac::alpha() const { return std::exp(log_alpha_.item<double>()); }
@@ -107,9 +105,7 @@ void Sac::update() {
     }
   }
   if (counters_.updates % config_.target_network_frequency == 0) {
-    soft_update(*target_->critic_encoder, *nets_->critic_encoder, config_.tau);
-    soft_update(*target_->critic1, *nets_->critic1, config_.tau);
-    soft_update(*target_->critic2, *nets_->critic2, config_.tau);
+    soft_update(target_critic_, critic_optimizer_->parameters(), config_.tau);
   }
 }
 
@@ -117,7 +113,8 @@ Sac::CheckpointParts Sac::checkpoint_parts() const {
   return {{{"networks", nets_.ptr().get()}, {"target_networks", target_.ptr().get()}},
           {{"actor_optimizer", actor_optimizer_.get()},
            {"critic_optimizer", critic_optimizer_.get()},
-           {"alpha_optimizer", alpha_optimizer_.get()}}};
+           {"alpha_optimizer", alpha_optimizer_.get()}},
+          {&target_critic_}};
 }
 
 void Sac::write_extra(torch::serialize::OutputArchive& a) const { a.write("log_alpha", log_alpha_.detach()); }

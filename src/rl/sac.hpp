@@ -44,7 +44,9 @@ class Sac final : public OffPolicyLearner {
   SacConfig config_;
   ActorCritic nets_{nullptr}, target_{nullptr};
   torch::Tensor log_alpha_;
-  std::unique_ptr<torch::optim::Adam> actor_optimizer_, critic_optimizer_, alpha_optimizer_;
+  std::unique_ptr<FlatAdam> actor_optimizer_, critic_optimizer_, alpha_optimizer_;
+  // The target networks' critic parameters, laid out as critic_optimizer_'s (one Polyak step).
+  mutable FlatParameters target_critic_;
 };
 
 }  // namespace comorph::rl

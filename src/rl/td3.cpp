@@ -39,10 +39,10 @@ Td3::Td3(const ObservationSpec& observation, int action_dims, const Td3Config& c
     : OffPolicyLearner("td3", "networks", observation, {ActionKind::kContinuous, action_dims}, config, seed),
       action_dims_(action_dims), config_(config) {
   build_networks(seed, nets_, target_, [&] { return make_networks(spec_, action_dims, config); });
-  actor_optimizer_ = std::make_unique<torch::optim::Adam>(
-      nets_->actor_parameters(), torch::optim::AdamOptions(config.actor_learning_rate));
-  critic_optimizer_ = std::make_unique<torch::optim::Adam>(
-      nets_->critic_parameters(), torch::optim::AdamOptions(config.critic_learning_rate));
+  actor_optimizer_ = make_adam(nets_->actor_parameters(), config.actor_learning_rate);
+  critic_optimizer_ = make_adam(nets_->critic_parameters(), config.critic_learning_rate);
+  target_actor_ = FlatParameters(target_->actor_parameters(), /*with_grad=*/false);
+  target_critic_ = FlatParameters(target_->critic_parameters(), /*with_grad=*/false);
 }
 
 double Td3::exploration_noise() const { return noise_std(config_, counters_); }
@@ -95,13 +95,15 @@ void Td3::update() {
       actor_loss = -q.mean();
     }
     gradient_step(*actor_optimizer_, actor_loss, config_.max_grad_norm);
-    soft_update(*target_, *nets_, config_.tau);
+    soft_update(target_actor_, actor_optimizer_->parameters(), config_.tau);
+    soft_update(target_critic_, critic_optimizer_->parameters(), config_.tau);
   }
 }
 
 Td3::CheckpointParts Td3::checkpoint_parts() const {
   return {{{"networks", nets_.ptr().get()}, {"target_networks", target_.ptr().get()}},
-          {{"actor_optimizer", actor_optimizer_.get()}, {"critic_optimizer", critic_optimizer_.get()}}};
+          {{"actor_optimizer", actor_optimizer_.get()}, {"critic_optimizer", critic_optimizer_.get()}},
+          {&target_actor_, &target_critic_}};
 }
 
 std::unique_ptr<Policy> Td3::policy(const ObservationSpec& observation, int action_dims, const Td3Config& config,

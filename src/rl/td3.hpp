@@ -42,7 +42,9 @@ class Td3 final : public OffPolicyLearner {
   int action_dims_;
   Td3Config config_;
   ActorCritic nets_{nullptr}, target_{nullptr};
-  std::unique_ptr<torch::optim::Adam> actor_optimizer_, critic_optimizer_;
+  std::unique_ptr<FlatAdam> actor_optimizer_, critic_optimizer_;  // over nets_'s actor and critic parameters
+  // The target networks' actor and critic parameters, laid out as the optimizers' (one Polyak step each).
+  mutable FlatParameters target_actor_, target_critic_;
 };
 
 }  // namespace comorph::rl

@@ -12,6 +12,7 @@
 #include "rl/classic/cartpole.hpp"
 #include "rl/classic/pendulum.hpp"
 #include "rl/dqn.hpp"
+#include "rl/flat_adam.hpp"
 #include "rl/networks.hpp"
 #include "rl/replay_buffer.hpp"
 #include "rl/sac.hpp"
@@ -269,14 +270,84 @@ TEST(Networks, SharedEncoderGetsNoGradientFromTheActor) {
   EXPECT_GT(separate->actor_parameters().size(), separate->actor->parameters().size());
 }
 
-TEST(Networks, SoftUpdateIsPolyakAverage) {
+TEST(Networks, SoftUpdateIsPolyakAverageOverTheFlatBuffers) {
   rl::Mlp a(3, std::vector<int>{4}, 2), b(3, std::vector<int>{4}, 2);
   rl::copy_parameters(*b, *a);
   EXPECT_TRUE(torch::equal(a->parameters()[0], b->parameters()[0]));
   rl::Mlp c(3, std::vector<int>{4}, 2);
-  const torch::Tensor before = b->parameters()[0].clone();
-  rl::soft_update(*b, *c, 0.25);
-  EXPECT_TRUE(torch::allclose(b->parameters()[0], 0.75 * before + 0.25 * c->parameters()[0]));
+  const torch::Tensor before = b->parameters()[2].clone();
+  rl::FlatParameters flat_b(b->parameters(), false), flat_c(c->parameters(), false);
+  EXPECT_TRUE(torch::equal(b->parameters()[2], before));  // flattening keeps the values
+  rl::soft_update(flat_b, flat_c, 0.25);
+  // The module's own parameter moved: it is a view of the buffer.
+  EXPECT_TRUE(torch::allclose(b->parameters()[2], 0.75 * before + 0.25 * c->parameters()[2]));
+}
+
+// FlatAdam must step exactly as torch's Adam over the same tensors (its
+// arithmetic, per element), with clipping as clip_grad_norm_, and survive a
+// module load (new storage) through rebind().
+TEST(FlatAdam, StepsAsTorchAdamWithClippingAndAfterAModuleLoad) {
+  torch::manual_seed(3);
+  rl::Mlp reference(5, std::vector<int>{16, 16}, 3), flat(5, std::vector<int>{16, 16}, 3);
+  rl::copy_parameters(*flat, *reference);
+  torch::optim::Adam torch_adam(reference->parameters(), torch::optim::AdamOptions(3e-3));
+  rl::FlatAdam flat_adam(flat->parameters(), {3e-3, 0.9, 0.999, 1e-8});
+  const auto step_both = [&](double max_norm) {
+    const torch::Tensor x = torch::randn({32, 5}), y = torch::randn({32, 3});
+    torch_adam.zero_grad();
+    torch::mse_loss(reference->forward(x), y).backward();
+    if (max_norm > 0) torch::nn::utils::clip_grad_norm_(reference->parameters(), max_norm);
+    torch_adam.step();
+    flat_adam.zero_grad();
+    torch::mse_loss(flat->forward(x), y).backward();
+    if (max_norm > 0) flat_adam.clip_grad_norm(max_norm);
+    flat_adam.step();
+  };
+  const auto expect_same = [&](const char* when) {
+    const auto r = reference->parameters(), f = flat->parameters();
+    for (std::size_t i = 0; i < r.size(); ++i)
+      EXPECT_TRUE(torch::allclose(r[i], f[i], 1e-5, 1e-6)) << when << ", tensor " << i;
+  };
+  for (int i = 0; i < 20; ++i) step_both(0);
+  expect_same("unclipped");
+  for (int i = 0; i < 20; ++i) step_both(0.05);  // small enough to clip every step
+  expect_same("clipped");
+  EXPECT_EQ(flat_adam.steps(), 40);
+  // The gradients live in the flat buffer: backward filled it.
+  EXPECT_GT(flat_adam.parameters().grad().abs().sum().item<double>(), 0.0);
+
+  // A module load replaces the parameters' storage; after rebind() the
+  // optimizer steps the loaded values.
+  const std::string path = temp_path("flat_adam_mlp.pt");
+  torch::save(reference, path);
+  torch::load(flat, path);
+  flat_adam.rebind();
+  EXPECT_TRUE(torch::equal(flat_adam.parameters().data(), torch::cat([&] {
+    std::vector<torch::Tensor> v;
+    for (const auto& p : reference->parameters()) v.push_back(p.detach().reshape({-1}));
+    return v;
+  }()))) << "rebind copies the loaded values into the buffer";
+  for (int i = 0; i < 5; ++i) step_both(0);
+  expect_same("after a load and rebind");
+  std::filesystem::remove(path);
+
+  // The optimizer state round-trips, and a state of another size is refused.
+  torch::serialize::OutputArchive out;
+  flat_adam.save(out);
+  const std::string state_path = temp_path("flat_adam_state.pt");
+  out.save_to(state_path);
+  torch::serialize::InputArchive in;
+  in.load_from(state_path);
+  rl::Mlp other(5, std::vector<int>{8}, 3);
+  rl::FlatAdam wrong_size(other->parameters(), {});
+  EXPECT_THROW(wrong_size.load(in), std::runtime_error);
+  rl::Mlp same(5, std::vector<int>{16, 16}, 3);
+  rl::FlatAdam restored(same->parameters(), {});
+  torch::serialize::InputArchive in2;
+  in2.load_from(state_path);
+  restored.load(in2);
+  EXPECT_EQ(restored.steps(), 45);
+  std::filesystem::remove(state_path);
 }
 
 // ---- DQN masking and targets ------------------------------------------------------
