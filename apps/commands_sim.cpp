@@ -22,6 +22,13 @@ namespace {
 
 using namespace comorph;
 
+// CLI check of an option naming a value of enum E: "" or the names it takes.
+template <class E>
+std::string enum_name_check(const std::string& name) {
+  E value;
+  return enum_from_name(name, value) ? std::string() : "not one of " + enum_name_list<E>();
+}
+
 struct SimOptions {
   std::string config_dir;  // "": configs/sim of resource_dir()
   int modules = 4;
@@ -214,18 +221,12 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   demo->add_option("--pilot-steering", steering,
                    "flat area: " + enum_name_list<task::FlatSteering>() +
                        " (a path on the true layout | towards the scan's open direction nearest the target)")
-      ->check([](const std::string& v) {
-        task::FlatSteering s;
-        return enum_from_name(v, s) ? std::string() : "not one of " + enum_name_list<task::FlatSteering>();
-      });
+      ->check(enum_name_check<task::FlatSteering>);
   static std::string stair_steering = "straight";
   demo->add_option("--pilot-stair-steering", stair_steering,
                    "stairs: " + enum_name_list<task::StairSteering>() +
                        " (up the middle | around the obstacles the scan shows on the treads)")
-      ->check([](const std::string& v) {
-        task::StairSteering s;
-        return enum_from_name(v, s) ? std::string() : "not one of " + enum_name_list<task::StairSteering>();
-      });
+      ->check(enum_name_check<task::StairSteering>);
   demo->add_option("--scan-columns", o.scan_columns,
                    "rays of the obstacle scan when the pilot steers by it, where the config has none")
       ->capture_default_str()

@@ -93,27 +93,23 @@ void OffPolicyLearner::load(const std::string& path) {
   a.load_from(path, device_);
   read_common(a, counters_, rng_, algorithm_);
   const CheckpointParts parts = checkpoint_parts();
-  const auto rebind = [&] {
-    for (const auto& [key, optimizer] : parts.optimizers) optimizer->rebind();
-    for (FlatParameters* f : parts.flat) f->rebind();
-  };
-  if (read_policy_only(a, key_, acting_module())) {
-    rebind();
-    return;
+  if (!read_policy_only(a, key_, acting_module())) {
+    for (const auto& [key, module] : parts.modules) {
+      torch::serialize::InputArchive part;
+      a.read(key, part);
+      module->load(part);
+    }
+    read_extra(a);
+    for (const auto& [key, optimizer] : parts.optimizers) {
+      torch::serialize::InputArchive part;
+      a.read(key, part);
+      optimizer->load(part);
+    }
+    read_replay(a, replay_);
   }
-  for (const auto& [key, module] : parts.modules) {
-    torch::serialize::InputArchive part;
-    a.read(key, part);
-    module->load(part);
-  }
-  read_extra(a);
-  for (const auto& [key, optimizer] : parts.optimizers) {
-    torch::serialize::InputArchive part;
-    a.read(key, part);
-    optimizer->load(part);
-  }
-  rebind();
-  read_replay(a, replay_);
+  // A module load gave the parameters new storage: make them views of the flat buffers again.
+  for (const auto& [key, optimizer] : parts.optimizers) optimizer->rebind();
+  for (FlatParameters* f : parts.flat) f->rebind();
 }
 
 }  // namespace comorph::rl

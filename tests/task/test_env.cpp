@@ -30,6 +30,19 @@ task::EpisodeSpec spec(std::uint64_t seed, int modules, double h = 0, int k = -1
   return s;
 }
 
+// One episode of `s` driven by the pilot (planned first); how it ended.
+Termination pilot_episode(task::MultiTaskEnv& env, task::ScriptedPilot& pilot, const task::EpisodeSpec& s) {
+  env.reset(s);
+  pilot.plan(env);
+  float a[5];
+  control::MotionMode mode;
+  while (!env.done()) {
+    pilot.act(env, a, mode);
+    env.step(a, mode);
+  }
+  return env.last().reason;
+}
+
 }  // namespace
 
 TEST(Env, SameSeedAndActionsGiveTheSameTrajectory) {
@@ -133,16 +146,9 @@ TEST(Env, ScanSteeredPilotCrossesTheObstacleField) {
   int successes = 0, collisions = 0;
   for (int modules : {2, 4})
     for (std::uint64_t seed = 100; seed < 106; ++seed) {
-      env.reset(spec(seed, modules, 0.04));
-      pilot.plan(env);
-      float a[5];
-      control::MotionMode mode;
-      while (!env.done()) {
-        pilot.act(env, a, mode);
-        env.step(a, mode);
-      }
-      successes += env.last().reason == Termination::success;
-      collisions += env.last().reason == Termination::collision;
+      const Termination reason = pilot_episode(env, pilot, spec(seed, modules, 0.04));
+      successes += reason == Termination::success;
+      collisions += reason == Termination::collision;
     }
   EXPECT_GE(successes, 11) << collisions << " collisions";
 }
@@ -165,15 +171,7 @@ TEST(Env, StairScanSteeringAvoidsObstaclesOnTheTreads) {
     for (std::uint64_t seed = 500; seed < 524; ++seed) {
       task::EpisodeSpec s = spec(seed, 2, 0.04);
       s.variant = sim::Variant::mixed;
-      env.reset(s);
-      pilot.plan(env);
-      float a[5];
-      control::MotionMode mode;
-      while (!env.done()) {
-        pilot.act(env, a, mode);
-        env.step(a, mode);
-      }
-      n += env.last().reason == Termination::success;
+      n += pilot_episode(env, pilot, s) == Termination::success;
     }
     return n;
   };
