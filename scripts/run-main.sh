@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The main job of `make run`: train the scene classifier (ResNet-18 on labelled
 # simulator depth images, ~2 minutes) into runs/classifier, train the quick
-# preset (configs/quick.yaml, about 12 minutes on 2 cores) into runs/quick with
+# preset (configs/quick.yaml, about 16 minutes on 2 cores) into runs/quick with
 # that classifier driving the scene-switch detector, evaluate it greedily on the
 # paper's protocol (stair heights 0.04/0.06/0.08 m), render one evaluation
 # episode per stair height to video, write the report (tables beside the
