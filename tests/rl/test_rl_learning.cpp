@@ -225,6 +225,42 @@ TEST(Learning, DqnLearnsCorridorValues) {
   }
 }
 
+// One decision, two chains: a risky one returns 10 in 70 % of the cases and 0
+// otherwise (mean 7, median 10), a sure one always 9. With returns far above
+// the Huber loss's delta of 1, its gradient is the error's sign, so Huber
+// regresses the median and prefers the risky chain; MSE learns the means and
+// prefers the sure one. The configuration model's returns (hundreds, with
+// stalls on the stairs among them) are in this regime (configs/standard.yaml).
+TEST(Learning, DqnMseLearnsMeanReturnsWhereHuberLearnsMedians) {
+  const rl::ObservationSpec spec{0, 0, 0, 1};
+  rl::Observation o;
+  o.vector = {1.0f};
+  for (const char* loss : {"mse", "huber"}) {
+    YAML::Node config = small_dqn();
+    config["loss"] = loss;
+    config["train_frequency"] = 1;
+    auto learner = rl::make_learner("dqn", spec, {rl::ActionKind::kDiscrete, 2}, config, "test", 1);
+    std::mt19937_64 rng(7);
+    std::bernoulli_distribution risky_pays(0.7);
+    rl::Action a;
+    for (int i = 0; i < 3000; ++i) {
+      a.discrete = i % 2;
+      const float r = a.discrete == 0 ? (risky_pays(rng) ? 10.0f : 0.0f) : 9.0f;
+      learner->store(o, a, r, o, /*terminated=*/true, false);
+      for (int u = learner->updates_due(); u > 0; --u) learner->update();
+    }
+    const std::vector<float> q = static_cast<rl::Dqn&>(*learner).q_values(o);
+    if (std::string(loss) == "mse") {
+      EXPECT_NEAR(q[0], 7.0, 0.8);
+      EXPECT_NEAR(q[1], 9.0, 0.5);
+      EXPECT_LT(q[0], q[1]);
+    } else {
+      EXPECT_GT(q[0], 9.3) << "Huber: the risky chain's median, 10";
+      EXPECT_GT(q[0], q[1]);
+    }
+  }
+}
+
 TEST(Learning, Td3DrivesPointToOrigin) {
   PointEnv env, eval_env;
   env.seed(1);
