@@ -10,8 +10,10 @@
 
 #include "command_registry.hpp"
 #include "common/file_io.hpp"
+#include "common/heap.hpp"
 
 int main(int argc, char** argv) {
+  comorph::keep_freed_memory_for_reuse();  // before the first allocation of note
   CLI::App app{"comorph: co-optimize the configuration and the motion of a chain-type "
                "modular robot with hierarchical deep RL"};
   app.require_subcommand(1);

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "common/heap.hpp"
 #include "common/resources.hpp"
 #include "coopt/config.hpp"
 #include "coopt/trainer.hpp"
@@ -63,6 +64,7 @@ nlohmann::ordered_json shares(const coopt::TrainerTiming& t, bool learner_thread
 }  // namespace
 
 int main(int argc, char** argv) {
+  comorph::keep_freed_memory_for_reuse();  // as comorph does
   CLI::App app{"Throughput of the hierarchical trainer for a preset: steps/s, each side alone, shares of wall time"};
   std::string config_path = resource_path("configs/quick.yaml");
   std::vector<std::string> sets;
