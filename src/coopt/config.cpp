@@ -162,7 +162,7 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
   if (!root.IsMap()) throw std::runtime_error(source + ": expected a mapping of sections");
   for (const auto& s : sets) apply_set(root, s);
   const std::string src = sets.empty() ? source : source + " (with --set)";
-  check_keys(root, src, "", {"trainer", "td3", "sac", "dqn", "env", "perception", "eval"});
+  check_keys(root, src, "", {"trainer", "td3", "sac", "dqn", "dqn_refit", "env", "perception", "eval"});
 
   CooptConfig c;
   c.trainer = read_trainer(root["trainer"], src);
@@ -201,6 +201,17 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
   c.td3 = rl::Td3Config::from_yaml(root["td3"], src + ": td3");
   c.sac = rl::SacConfig::from_yaml(root["sac"], src + ": sac");
   c.dqn = rl::DqnConfig::from_yaml(root["dqn"], src + ": dqn");
+  c.dqn_refit = c.dqn;
+  if (given("dqn_refit")) {  // read also where no DQN is refitted (a preset's fixed columns): checked all the same
+    YAML::Node merged = given("dqn") ? YAML::Clone(root["dqn"]) : YAML::Node(YAML::NodeType::Map);
+    if (!root["dqn_refit"].IsMap()) throw std::runtime_error(src + ": dqn_refit: expected a mapping of dqn keys");
+    for (const auto& kv : root["dqn_refit"]) merged[kv.first.as<std::string>()] = kv.second;
+    c.dqn_refit = rl::DqnConfig::from_yaml(merged, src + ": dqn_refit (over dqn)");
+    if (c.dqn_refit.hidden_sizes != c.dqn.hidden_sizes || c.dqn_refit.image_features != c.dqn.image_features ||
+        c.dqn_refit.image_fc_size != c.dqn.image_fc_size)
+      throw std::runtime_error(src + ": dqn_refit: hidden_sizes, image_features and image_fc_size must be dqn:'s "
+                                     "(evaluation and export load the training or the refit DQN alike)");
+  }
   if (given("td3") && (c.td3.random_action_episodes != 0 || c.td3.random_action_steps != 0))
     throw std::runtime_error(src + ": field 'td3.random_action_episodes/steps': must be 0, "
                                    "the warm-up is trainer.warmup_episodes (both models)");

@@ -5,6 +5,8 @@
 //   td3:        rl::Td3Config fields   (motion model, trainer.motion_algo: td3)
 //   sac:        rl::SacConfig fields   (motion model, trainer.motion_algo: sac)
 //   dqn:        rl::DqnConfig fields   (configuration model)
+//   dqn_refit:  rl::DqnConfig fields that differ for the refit DQN
+//               (trainer.config_refit_episodes); the rest are dqn:'s
 //   env:        {robot, scene, motion, task}: overrides of configs/sim/*.yaml
 //   perception: {classifier, switch_detector} (configs/perception.yaml layout)
 //   eval:       EvalParams below
@@ -116,8 +118,8 @@ struct TrainerParams {
   // of the course is shorter by as much, which bootstrapping does not see.
   ConfigTarget config_target = ConfigTarget::bootstrap;
   // After the training episodes, this many more in which the motion model is
-  // frozen and greedy and a fresh DQN (the dqn: section, its own epsilon
-  // schedule) learns from every decision. Its values then describe the final
+  // frozen and greedy and a fresh DQN (the dqn: section with dqn_refit:'s
+  // keys over it, its own epsilon schedule) learns from every decision. Its values then describe the final
   // motion model; during training they mix every stage of it, and the early
   // ones stay in its replay. 0 = none.
   int config_refit_episodes = 0;
@@ -156,6 +158,9 @@ struct CooptConfig {
   rl::Td3Config td3;
   rl::SacConfig sac;
   rl::DqnConfig dqn;
+  // The refit DQN's (trainer.config_refit_episodes): dqn: with the keys of
+  // dqn_refit: over it. Its network is dqn:'s (evaluation loads either model).
+  rl::DqnConfig dqn_refit;
   // The merged YAML (file + --set): what the run directory's config.yaml holds
   // and what a checkpoint is compared against.
   std::string text;

@@ -98,7 +98,7 @@ EpisodeLog Trainer::Impl::train_episode() {
   // greedy motion model; no pilot, nothing stored for the motion learner.
   const bool refit = state.episode >= t.warmup_episodes + t.episodes;
   if (refit && state.episode == t.warmup_episodes + t.episodes) {
-    state.agent.config = make_config_model(config, static_cast<std::uint64_t>(t.seed) + 3);
+    state.agent.config = make_refit_config_model(config);
     state.config_segments = {};  // its replay starts empty: no segment of the old one to link
   }
   LearnHooks hooks;

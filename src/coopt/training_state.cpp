@@ -29,14 +29,24 @@ std::unique_ptr<rl::Policy> make_motion_policy(const CooptConfig& c, std::uint64
   return rl::make_policy(c.trainer.motion_algo, motion_args(c, seed));
 }
 
-std::unique_ptr<rl::Learner> make_config_model(const CooptConfig& c, std::uint64_t seed) {
+namespace {
+std::unique_ptr<rl::Learner> make_dqn(const CooptConfig& c, std::uint64_t seed, const rl::DqnConfig& params) {
   if (c.trainer.mode != TrainerMode::hierarchical) return nullptr;
   rl::LearnerArgs a;
   a.observation = config_spec(c);
   a.action = {rl::ActionKind::kDiscrete, kCandidates};
   a.seed = seed;
-  a.config = c.dqn;
+  a.config = params;
   return rl::make_learner("dqn", a);
+}
+}  // namespace
+
+std::unique_ptr<rl::Learner> make_config_model(const CooptConfig& c, std::uint64_t seed) {
+  return make_dqn(c, seed, c.dqn);
+}
+
+std::unique_ptr<rl::Learner> make_refit_config_model(const CooptConfig& c) {
+  return make_dqn(c, static_cast<std::uint64_t>(c.trainer.seed) + 3, c.dqn_refit);
 }
 
 TrainingState::TrainingState(const CooptConfig& c) : rng(c.trainer.seed * 7919ULL + 17) {

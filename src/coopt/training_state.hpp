@@ -36,9 +36,11 @@ struct TrainingState {
 // The models by name (rl/registry.hpp): the motion model's learner and its
 // policy (td3: and sac: are the config's typed sections; another registered
 // learner keeps its defaults), and the configuration model (a DQN over the
-// candidate chains; none in fixed mode).
+// candidate chains; none in fixed mode), and the fresh one of the DQN refit
+// (trainer.config_refit_episodes; the dqn_refit: hyperparameters).
 std::unique_ptr<rl::Learner> make_motion_learner(const CooptConfig& c, std::uint64_t seed);
 std::unique_ptr<rl::Policy> make_motion_policy(const CooptConfig& c, std::uint64_t seed);
 std::unique_ptr<rl::Learner> make_config_model(const CooptConfig& c, std::uint64_t seed);
+std::unique_ptr<rl::Learner> make_refit_config_model(const CooptConfig& c);
 
 }  // namespace comorph::coopt

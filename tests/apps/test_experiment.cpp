@@ -71,13 +71,13 @@ TEST(Experiment, Table2TrainsEveryColumnWritesTheTableAndResumesWithoutRetrainin
 
 // A preset with a DQN refit (configs/standard.yaml) still has fixed columns: a
 // fixed chain has no DQN, so its motion model trains for the hierarchy's
-// warm-up and training episodes and nothing is refitted.
+// warm-up and training episodes and nothing is refitted (its dqn_refit: unused).
 TEST(Experiment, FixedColumnOfAPresetWithADqnRefitTrainsTheMotionBudgetOnly) {
   const fs::path out = fs::temp_directory_path() / ("comorph_experiment_refit_" + std::to_string(::getpid()));
   fs::remove_all(out);
   std::string log;
   ASSERT_EQ(run_cli("experiment --table 1 --only fixed-2 --config " + kCi +
-                        " --set trainer.config_refit_episodes=3 --eval-episodes 3 --eval-seed 8123000 --out " +
+                        " --set trainer.config_refit_episodes=3 --set dqn_refit.loss=mse --eval-episodes 3 --eval-seed 8123000 --out " +
                         out.string(),
                     log),
             0)

@@ -121,6 +121,23 @@ TEST(CooptConfig, UnknownKeysAndOutOfRangeValuesNameTheKey) {
   expect_error({"trainer.episodes"}, "key=value");
 }
 
+// dqn_refit: holds only the keys in which the refit DQN differs from dqn:.
+TEST(CooptConfig, DqnRefitOverlaysTheDqnSection) {
+  const CooptConfig plain = load_coopt_config(kCi, {"trainer.config_refit_episodes=2"});
+  EXPECT_EQ(plain.dqn_refit.loss, plain.dqn.loss);
+  EXPECT_EQ(plain.dqn_refit.batch_size, plain.dqn.batch_size);
+  const CooptConfig c = load_coopt_config(
+      kCi, {"trainer.config_refit_episodes=2", "dqn.loss=huber", "dqn_refit.loss=mse", "dqn_refit.batch_size=7"});
+  EXPECT_EQ(c.dqn.loss, rl::DqnLoss::huber);
+  EXPECT_EQ(c.dqn_refit.loss, rl::DqnLoss::mse);
+  EXPECT_EQ(c.dqn_refit.batch_size, 7);
+  EXPECT_NE(c.dqn.batch_size, 7);
+  EXPECT_EQ(c.dqn_refit.learning_rate, c.dqn.learning_rate);  // the rest is dqn:'s
+  EXPECT_EQ(c.dqn_refit.hidden_sizes, c.dqn.hidden_sizes);
+  expect_error({"trainer.config_refit_episodes=2", "dqn_refit.los=mse"}, "dqn_refit (over dqn)");
+  expect_error({"trainer.config_refit_episodes=2", "dqn_refit.hidden_sizes=[9]"}, "dqn_refit: hidden_sizes");
+}
+
 TEST(Scenario, NamesMapToObstaclesAndVariant) {
   EXPECT_EQ(task::scenario_named("default").obstacles, -1);
   EXPECT_EQ(task::scenario_named("default").variant, sim::Variant::standard);
