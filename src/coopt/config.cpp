@@ -202,7 +202,7 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
   c.sac = rl::SacConfig::from_yaml(root["sac"], src + ": sac");
   c.dqn = rl::DqnConfig::from_yaml(root["dqn"], src + ": dqn");
   c.dqn_refit = c.dqn;
-  if (given("dqn_refit")) {  // read also where no DQN is refitted (a preset's fixed columns): checked all the same
+  if (given("dqn_refit")) {  // checked also where no DQN is refitted (a preset's fixed columns)
     YAML::Node merged = given("dqn") ? YAML::Clone(root["dqn"]) : YAML::Node(YAML::NodeType::Map);
     if (!root["dqn_refit"].IsMap()) throw std::runtime_error(src + ": dqn_refit: expected a mapping of dqn keys");
     for (const auto& kv : root["dqn_refit"]) merged[kv.first.as<std::string>()] = kv.second;
@@ -218,6 +218,10 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
   if (given("sac") && (c.sac.random_action_episodes != 0 || c.sac.random_action_steps != 0))
     throw std::runtime_error(src + ": field 'sac.random_action_episodes/steps': must be 0, "
                                    "the warm-up is trainer.warmup_episodes (both models)");
+  // Where no DQN is refitted (a fixed chain, or config_refit_episodes 0) dqn_refit: is no part of the run:
+  // a preset's fixed columns stay the same runs whatever it holds.
+  if (given("dqn_refit") && (c.trainer.mode != TrainerMode::hierarchical || c.trainer.config_refit_episodes == 0))
+    root.remove("dqn_refit");
   c.text = dump(root);
   c.preset = std::filesystem::path(source).stem().string();
   return c;

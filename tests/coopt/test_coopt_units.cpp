@@ -134,6 +134,12 @@ TEST(CooptConfig, DqnRefitOverlaysTheDqnSection) {
   EXPECT_NE(c.dqn.batch_size, 7);
   EXPECT_EQ(c.dqn_refit.learning_rate, c.dqn.learning_rate);  // the rest is dqn:'s
   EXPECT_EQ(c.dqn_refit.hidden_sizes, c.dqn.hidden_sizes);
+  EXPECT_NE(c.text.find("dqn_refit"), std::string::npos);
+  // Where nothing is refitted it is no part of the run's identity: a preset's
+  // fixed columns are the same runs with and without it.
+  for (const char* no_refit : {"trainer.config_refit_episodes=0", "trainer.mode=fixed"})
+    EXPECT_EQ(load_coopt_config(kCi, {no_refit, "dqn_refit.loss=mse"}).text, load_coopt_config(kCi, {no_refit}).text)
+        << no_refit;
   expect_error({"trainer.config_refit_episodes=2", "dqn_refit.los=mse"}, "dqn_refit (over dqn)");
   expect_error({"trainer.config_refit_episodes=2", "dqn_refit.hidden_sizes=[9]"}, "dqn_refit: hidden_sizes");
 }
