@@ -76,6 +76,11 @@ void Dqn::act(const Observation& o, bool explore, Action& action) {
 
 torch::Tensor Dqn::td_target(const ReplayBatch& b) {
   torch::NoGradGuard no_grad;
+  // A batch of terminal transitions only (the co-optimization's return
+  // targets) bootstraps nothing: the target network's forward pass, about a
+  // quarter of an update, is skipped. The same numbers: the bootstrap term
+  // would be 0 times a finite value.
+  if (!b.bootstrap.any().item<bool>()) return b.reward.clone();
   {
     const torch::Tensor valid = b.next_valid_actions;
     const torch::Tensor q_next = q_target_->forward(b.next_image, b.next_vector);

@@ -409,6 +409,10 @@ TEST(Dqn, TargetMaximisesOverNextValidActionsAndRespectsTermination) {
   EXPECT_EQ(y[1].item<float>(), 1.0f);
   EXPECT_NEAR(y[2].item<float>(), 1.0f + std::pow(0.9f, 3) * best_valid, 1e-5);
   EXPECT_EQ(y[3].item<float>(), 2.0f);
+  // A batch of terminal transitions only (the trainer's return targets): their rewards.
+  const torch::Tensor y_terminal = dqn.td_target(dqn.replay().gather(torch::tensor({1, 3}, torch::kLong), torch::kCPU));
+  EXPECT_EQ(y_terminal[0].item<float>(), 1.0f);
+  EXPECT_EQ(y_terminal[1].item<float>(), 2.0f);
   // The masked max differs from the unmasked one when an invalid action is best.
   const float best_any = q_next.max().item<float>();
   if (best_any != best_valid) {
