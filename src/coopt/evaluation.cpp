@@ -76,14 +76,18 @@ std::vector<EpisodeLog> evaluate(const CooptConfig& run_config, const std::strin
   }
   std::vector<EpisodeLog> logs(static_cast<std::size_t>(request.episodes));
   std::atomic<int> next{0};
-  std::mutex error_mutex;
+  std::mutex error_mutex, progress_mutex;
   std::exception_ptr error;
+  int finished = 0;
   auto work = [&] {
     try {
       GreedyPlayer player(config, info);
       for (int i = next++; i < request.episodes; i = next++) {
         const auto spec = eval_spec(config, scenario, static_cast<std::uint64_t>(request.seed) + i, i);
         logs[static_cast<std::size_t>(i)] = player.play_episode(scenario, spec, i);
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        ++finished;
+        if (request.on_episode_finished) request.on_episode_finished(finished, request.episodes);
       }
     } catch (...) {
       std::lock_guard<std::mutex> lock(error_mutex);

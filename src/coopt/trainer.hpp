@@ -201,6 +201,9 @@ struct EvalRequest {
   int forced_modules = 0;            // > 0: the run's motion model drives a fixed chain of this many
                                      // modules (configuration model unused, no shedding): what the
                                      // motion model can do with each body
+  // Called after each finished episode with the number finished so far (one
+  // call at a time, from the worker that finished it): progress for the CLI.
+  std::function<void(int finished, int episodes)> on_episode_finished;
 };
 // Loads run_dir/checkpoint; results are ordered by episode and do not depend on `workers`.
 std::vector<EpisodeLog> evaluate(const CooptConfig& config, const std::string& run_dir,

@@ -3,6 +3,7 @@
 // eval-<scenario>.json, plus config.yaml, evaluations.csv and checkpoint/).
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -121,6 +122,17 @@ report::EvalSummary eval_run(const std::string& run_dir, const std::string& scen
   request.workers = workers > 0 ? workers : config.eval.workers;
   if (request.workers == 0) request.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   request.forced_modules = forced_modules;
+  // A progress line on stderr every 30 s and at the end: 300 episodes take minutes.
+  const auto started = std::chrono::steady_clock::now();
+  auto last_line = started;
+  request.on_episode_finished = [&](int finished, int total) {
+    const auto now = std::chrono::steady_clock::now();
+    if (finished < total && now - last_line < std::chrono::seconds(30)) return;
+    last_line = now;
+    const double s = std::chrono::duration<double>(now - started).count();
+    std::fprintf(stderr, "eval %s: %d/%d episodes, %.0f s, ETA %.0f s\n", scenario.c_str(), finished, total, s,
+                 s / finished * (total - finished));
+  };
   const auto logs = comorph::coopt::evaluate(config, run_dir, request);
 
   std::vector<comorph::report::EpisodeRecord> records;

@@ -54,6 +54,8 @@ TEST(ShippedResults, StandardHierarchicalPolicyStillSucceeds) {
             0)
       << read_text(work / "log.txt");
   ASSERT_EQ(run_in(work, "eval --run run --episodes 30 --seed 8100000 --workers 2"), 0) << read_text(work / "log.txt");
+  EXPECT_NE(read_text(work / "log.txt").find("eval default: 30/30 episodes"), std::string::npos)  // the last progress line
+      << read_text(work / "log.txt");
   const nlohmann::json j = nlohmann::json::parse(read_text(work / "run" / "eval-default.json"));
   const double success = j["success_rate"]["avg"].get<double>();
   std::printf("shipped standard hierarchical policy: %.1f %% success on 30 episodes (seeds 8100000..8100029)\n",

@@ -469,7 +469,14 @@ TEST(Evaluate, GreedyEpisodesCycleHeightsAndDoNotDependOnWorkers) {
   req.workers = 1;
   const auto one = evaluate(c, dir, req);
   req.workers = 2;
+  std::vector<int> finished;  // the progress callback: once per episode, counting up (one call at a time)
+  req.on_episode_finished = [&finished](int n, int total) {
+    EXPECT_EQ(total, 5);
+    finished.push_back(n);
+  };
   const auto two = evaluate(c, dir, req);
+  req.on_episode_finished = nullptr;
+  EXPECT_EQ(finished, (std::vector<int>{1, 2, 3, 4, 5}));
   ASSERT_EQ(one.size(), 5u);
   ASSERT_EQ(two.size(), 5u);
   for (int i = 0; i < 5; ++i) {
