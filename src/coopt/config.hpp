@@ -123,7 +123,9 @@ struct TrainerParams {
   // motion model; during training they mix every stage of it, and the early
   // ones stay in its replay. 0 = none.
   int config_refit_episodes = 0;
-  int total_episodes() const { return warmup_episodes + episodes + config_refit_episodes; }
+  // Episode index of the refit's first episode (= warm-up + training episodes).
+  int refit_start() const { return warmup_episodes + episodes; }
+  int total_episodes() const { return refit_start() + config_refit_episodes; }
   // Every training transition carries the pilot's action for its state as a
   // behaviour-cloning target (td3.bc_weight), also where the motion model drove:
   // the pilot labels the states the learner visits (DAgger, Ross et al. 2011).

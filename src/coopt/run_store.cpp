@@ -368,8 +368,7 @@ void RunStore::load_checkpoint(TrainingState& s, const CooptConfig& config) cons
   load_learner_file(*s.agent.motion, (fs::path(info.directory) / "motion_actor.pt").string());
   if (s.agent.config) {
     // Inside the DQN refit the checkpoint holds the refit DQN: built with its own hyperparameters.
-    const TrainerParams& t = config.trainer;
-    if (info.episodes > t.warmup_episodes + t.episodes) s.agent.config = make_refit_config_model(config);
+    if (info.episodes > config.trainer.refit_start()) s.agent.config = make_refit_config_model(config);
     load_learner_file(*s.agent.config, (fs::path(info.directory) / "config_model.pt").string());
     s.config_segments = load_replay(*s.agent.config, "config_model", info.directory);
   }

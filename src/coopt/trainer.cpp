@@ -96,8 +96,8 @@ EpisodeLog Trainer::Impl::train_episode() {
   const bool warmup = state.episode < t.warmup_episodes;
   // The DQN refit (trainer.config_refit_episodes): a fresh DQN on the frozen,
   // greedy motion model; no pilot, nothing stored for the motion learner.
-  const bool refit = state.episode >= t.warmup_episodes + t.episodes;
-  if (refit && state.episode == t.warmup_episodes + t.episodes) {
+  const bool refit = state.episode >= t.refit_start();
+  if (refit && state.episode == t.refit_start()) {
     state.agent.config = make_refit_config_model(config);
     state.config_segments = {};  // its replay starts empty: no segment of the old one to link
   }
