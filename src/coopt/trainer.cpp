@@ -208,17 +208,23 @@ void Trainer::Impl::progress(const EpisodeLog& log) {
   if (recent_success.size() > 20) recent_success.erase(recent_success.begin());
   const TrainerParams& t = config.trainer;
   const int total = t.total_episodes();
+  recent_wall.push_back(wall());
+  if (recent_wall.size() > 101) recent_wall.pop_front();
   if (state.episode % t.progress_interval != 0 && state.episode != total) return;
   double rate = 0;
   for (double s : recent_success) rate += s;
   rate /= static_cast<double>(recent_success.size());
-  const double w = wall();
-  const double eta_s = state.episode > 0 ? w / state.episode * (total - state.episode) : 0;
+  const double w = recent_wall.back();
+  const int remaining = total - state.episode;
+  double eta_s = state.episode > 0 ? w / state.episode * remaining : 0;  // the run's average until 10 recent episodes
+  if (recent_wall.size() > 10)
+    eta_s = (w - recent_wall.front()) / static_cast<double>(recent_wall.size() - 1) * remaining;
   const std::string configs = task::configuration_sequence(log.configurations);
   std::fprintf(stderr,
-               "episode %d/%d%s | %d steps, return %.1f, %s | total %lld steps, %.0f steps/s | success %.0f %% "
+               "episode %d/%d%s%s | %d steps, return %.1f, %s | total %lld steps, %.0f steps/s | success %.0f %% "
                "(last %zu) | config %s (stairs %.2f m) | wall %.0f s, ETA %.0f s\n",
-               state.episode, total, log.warmup ? " (warm-up)" : "", log.steps, log.return_R1, log.termination.c_str(),
+               state.episode, total, log.warmup ? " (warm-up)" : "",
+               state.episode > t.refit_start() ? " (DQN refit)" : "", log.steps, log.return_R1, log.termination.c_str(),
                static_cast<long long>(state.steps), w > 0 ? state.steps / w : 0.0, 100.0 * rate, recent_success.size(),
                configs.c_str(), log.stair_height_m, w, eta_s);
 }

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <chrono>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -40,6 +41,9 @@ struct Trainer::Impl {
   Clock::time_point started = Clock::now();
   bool run_files = false;  // config.yaml, run.yaml and the CSV files exist (written by run(), or resumed)
   std::vector<double> recent_success;  // last 20 training episodes
+  // wall() at the end of the last episodes (up to 101): the ETA follows the
+  // current rate, since a refit episode costs several training episodes.
+  std::deque<double> recent_wall;
 
   // TrainerTiming: the acting thread's laps, run()'s wall time and checkpoints,
   // and the learner's job time (written by the job, read after worker->wait()).
