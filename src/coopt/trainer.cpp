@@ -215,10 +215,11 @@ void Trainer::Impl::progress(const EpisodeLog& log) {
   for (double s : recent_success) rate += s;
   rate /= static_cast<double>(recent_success.size());
   const double w = recent_wall.back();
-  const int remaining = total - state.episode;
-  double eta_s = state.episode > 0 ? w / state.episode * remaining : 0;  // the run's average until 10 recent episodes
-  if (recent_wall.size() > 10)
-    eta_s = (w - recent_wall.front()) / static_cast<double>(recent_wall.size() - 1) * remaining;
+  // Wall per episode over the recent ones once there are 10, the run's average before.
+  const double episode_s = recent_wall.size() > 10 ? (w - recent_wall.front()) / static_cast<double>(recent_wall.size() - 1)
+                           : state.episode > 0    ? w / state.episode
+                                                  : 0;
+  const double eta_s = episode_s * (total - state.episode);
   const std::string configs = task::configuration_sequence(log.configurations);
   std::fprintf(stderr,
                "episode %d/%d%s%s | %d steps, return %.1f, %s | total %lld steps, %.0f steps/s | success %.0f %% "
