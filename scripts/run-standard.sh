@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The standard preset end to end (docs/results.md): train the scene classifier
 # (runs/classifier, ~2 minutes), train configs/standard.yaml with the
-# classifier driving the switches (300 + 4000 episodes + 2000 of DQN refit;
-# 79 minutes for seed 1 on 2 cores, docs/results.md), then evaluate it greedily on
+# classifier driving the switches (300 + 4000 episodes + 1000 of DQN refit;
+# about 2 hours for seed 1 on 2 cores, docs/results.md), then evaluate it greedily on
 # 300 episodes (100 per stair height) of the config's eval seeds.
 # Usage: scripts/run-standard.sh [build_dir] [run_dir] [extra --set ...]
 # Interrupted? Run it again: it resumes the run from its last checkpoint.
