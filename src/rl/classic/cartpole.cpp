@@ -25,31 +25,36 @@ bool cartpole_step(const CartPoleParams& p, int action, CartPoleState& s) {
          theta > p.theta_threshold;
 }
 
-void CartPoleEnv::observe(Observation& o) const {
-  o.image.clear();
-  o.vector.resize(4);
-  for (int i = 0; i < 4; ++i) o.vector[i] = static_cast<float>(state_[i]);
-  o.valid_actions.assign(2, 1);  // both actions always valid
-}
+namespace {
 
-void CartPoleEnv::reset(Observation& observation) {
+CartPoleState initial_state(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(-0.05, 0.05);
-  for (double& v : state_) v = u(rng_);
-  steps_ = 0;
-  observe(observation);
+  CartPoleState s;
+  for (double& v : s) v = u(rng);
+  return s;
 }
 
-StepResult CartPoleEnv::step(const Action& action, Observation& next) {
+StepResult advance(const CartPoleParams& p, const Action& action, CartPoleState& s) {
   if (action.discrete != 0 && action.discrete != 1)
     throw std::invalid_argument("CartPoleEnv::step: action must be 0 or 1, got " +
                                 std::to_string(action.discrete));
   StepResult r;
-  r.terminated = cartpole_step(params_, action.discrete, state_);
+  r.terminated = cartpole_step(p, action.discrete, s);
   r.reward = 1.0f;  // also on the terminating step, as Gymnasium
-  ++steps_;
-  r.truncated = !r.terminated && steps_ >= params_.max_episode_steps;
-  observe(next);
   return r;
 }
+
+void observe(const CartPoleState& s, Observation& o) {
+  o.image.clear();
+  o.vector.resize(4);
+  for (int i = 0; i < 4; ++i) o.vector[i] = static_cast<float>(s[i]);
+  o.valid_actions.assign(2, 1);  // both actions always valid
+}
+
+}  // namespace
+
+CartPoleEnv::CartPoleEnv(CartPoleParams params)
+    : ClassicEnv({"CartPole-v1", {0, 0, 0, 4}, {ActionKind::kDiscrete, 2}, initial_state, advance, observe},
+                 params) {}
 
 }  // namespace comorph::rl

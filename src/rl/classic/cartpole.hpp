@@ -9,9 +9,8 @@
 #pragma once
 
 #include <array>
-#include <random>
 
-#include "rl/env.hpp"
+#include "rl/classic/classic_env.hpp"
 
 namespace comorph::rl {
 
@@ -33,26 +32,9 @@ using CartPoleState = std::array<double, 4>;  // x, x_dot, theta, theta_dot
 // state is terminal.
 bool cartpole_step(const CartPoleParams& params, int action, CartPoleState& state);
 
-class CartPoleEnv final : public Env {
+class CartPoleEnv final : public ClassicEnv<CartPoleParams, CartPoleState> {
  public:
-  explicit CartPoleEnv(CartPoleParams params = {}) : params_(params) {}
-  std::string name() const override { return "CartPole-v1"; }
-  ObservationSpec observation_spec() const override { return {0, 0, 0, 4}; }
-  ActionSpec action_spec() const override { return {ActionKind::kDiscrete, 2}; }
-  void seed(std::uint64_t seed) override { rng_.seed(seed); }
-  void reset(Observation& observation) override;
-  StepResult step(const Action& action, Observation& next_observation) override;
-
-  const CartPoleState& state() const { return state_; }
-  void set_state(const CartPoleState& state) { state_ = state; }
-
- private:
-  void observe(Observation& observation) const;
-
-  CartPoleParams params_;
-  CartPoleState state_{};
-  int steps_ = 0;
-  std::mt19937_64 rng_{0};
+  explicit CartPoleEnv(CartPoleParams params = {});
 };
 
 }  // namespace comorph::rl

@@ -26,36 +26,41 @@ double pendulum_step(const PendulumParams& p, double u, PendulumState& s) {
   return -cost;
 }
 
-void PendulumEnv::observe(Observation& o) const {
-  o.image.clear();
-  o.valid_actions.clear();
-  o.vector.resize(3);
-  o.vector[0] = static_cast<float>(std::cos(state_.theta));
-  o.vector[1] = static_cast<float>(std::sin(state_.theta));
-  o.vector[2] = static_cast<float>(state_.theta_dot);
-}
+namespace {
 
-void PendulumEnv::reset(Observation& observation) {
+PendulumState initial_state(std::mt19937_64& rng) {
   // Gymnasium: uniform(low=-[pi, 1], high=[pi, 1]).
   std::uniform_real_distribution<double> angle(-M_PI, M_PI), speed(-1.0, 1.0);
-  state_.theta = angle(rng_);
-  state_.theta_dot = speed(rng_);
-  steps_ = 0;
-  observe(observation);
+  PendulumState s;
+  s.theta = angle(rng);
+  s.theta_dot = speed(rng);
+  return s;
 }
 
-StepResult PendulumEnv::step(const Action& action, Observation& next) {
+StepResult advance(const PendulumParams& p, const Action& action, PendulumState& s) {
   if (action.continuous.size() != 1)
     throw std::invalid_argument("PendulumEnv::step: expected 1 continuous action, got " +
                                 std::to_string(action.continuous.size()));
-  const double u = static_cast<double>(action.continuous[0]) * params_.max_torque;
+  const double u = static_cast<double>(action.continuous[0]) * p.max_torque;
   StepResult r;
-  r.reward = static_cast<float>(pendulum_step(params_, u, state_));
-  ++steps_;
-  r.terminated = false;
-  r.truncated = steps_ >= params_.max_episode_steps;
-  observe(next);
+  r.reward = static_cast<float>(pendulum_step(p, u, s));
+  r.terminated = false;  // never: only the time limit ends an episode
   return r;
 }
+
+void observe(const PendulumState& s, Observation& o) {
+  o.image.clear();
+  o.valid_actions.clear();
+  o.vector.resize(3);
+  o.vector[0] = static_cast<float>(std::cos(s.theta));
+  o.vector[1] = static_cast<float>(std::sin(s.theta));
+  o.vector[2] = static_cast<float>(s.theta_dot);
+}
+
+}  // namespace
+
+PendulumEnv::PendulumEnv(PendulumParams params)
+    : ClassicEnv({"Pendulum-v1", {0, 0, 0, 3}, {ActionKind::kContinuous, 1}, initial_state, advance, observe},
+                 params) {}
 
 }  // namespace comorph::rl

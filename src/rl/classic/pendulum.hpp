@@ -9,9 +9,7 @@
 // Never terminates; truncated after 200 steps.
 #pragma once
 
-#include <random>
-
-#include "rl/env.hpp"
+#include "rl/classic/classic_env.hpp"
 
 namespace comorph::rl {
 
@@ -37,26 +35,9 @@ double pendulum_step(const PendulumParams& params, double u, PendulumState& stat
 // Wraps an angle to [-pi, pi), as Gymnasium's angle_normalize.
 double angle_normalize(double x);
 
-class PendulumEnv final : public Env {
+class PendulumEnv final : public ClassicEnv<PendulumParams, PendulumState> {
  public:
-  explicit PendulumEnv(PendulumParams params = {}) : params_(params) {}
-  std::string name() const override { return "Pendulum-v1"; }
-  ObservationSpec observation_spec() const override { return {0, 0, 0, 3}; }
-  ActionSpec action_spec() const override { return {ActionKind::kContinuous, 1}; }
-  void seed(std::uint64_t seed) override { rng_.seed(seed); }
-  void reset(Observation& observation) override;
-  StepResult step(const Action& action, Observation& next_observation) override;
-
-  const PendulumState& state() const { return state_; }
-  void set_state(const PendulumState& state) { state_ = state; }
-
- private:
-  void observe(Observation& observation) const;
-
-  PendulumParams params_;
-  PendulumState state_;
-  int steps_ = 0;
-  std::mt19937_64 rng_{0};
+  explicit PendulumEnv(PendulumParams params = {});
 };
 
 }  // namespace comorph::rl
