@@ -52,7 +52,6 @@ Td3Config Td3Config::from_yaml(const YAML::Node& node, const std::string& source
     add_linear_schedule(f, "exploration_noise", c.exploration_noise_start, c.exploration_noise_end,
                         c.exploration_noise_decay, 10.0);
     f.add("exploration_noise_unit", &c.exploration_noise_unit);
-    f.add("share_encoder", &c.share_encoder);
     f.add("bc_weight", &c.bc_weight, 0.0, 1000.0);
     f.add("bc_decay_updates", &c.bc_decay_updates, std::int64_t(0), std::int64_t(1) << 40);
   });
@@ -69,7 +68,6 @@ SacConfig SacConfig::from_yaml(const YAML::Node& node, const std::string& source
     f.add("target_entropy_scale", &c.target_entropy_scale, -100.0, 100.0);
     f.add("log_std_min", &c.log_std_min, -20.0, 10.0);
     f.add("log_std_max", &c.log_std_max, -20.0, 10.0);
-    f.add("share_encoder", &c.share_encoder);
   });
   if (!(c.log_std_min < c.log_std_max)) YamlFields(source).fail("log_std_max", "must be above log_std_min");
   return c;

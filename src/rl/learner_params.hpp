@@ -51,6 +51,7 @@ void add_actor_critic_fields(YamlFields& f, ActorCriticConfig& c) {
   f.add("critic_learning_rate", &c.critic_learning_rate, kMinPositive, 1.0);
   f.add("random_action_steps", &c.random_action_steps, 0, kMaxSteps);
   f.add("random_action_episodes", &c.random_action_episodes, 0, kMaxSteps);
+  f.add("share_encoder", &c.share_encoder);
 }
 
 // What the ranges of add_shared_learner_fields cannot say: layer widths
@@ -114,7 +115,18 @@ struct DqnConfig {
   static DqnConfig from_yaml(const YAML::Node& node, const std::string& source);
 };
 
-struct Td3Config {
+// The networks of TD3 and SAC (ActorCritic, rl/networks.hpp), their replay
+// images and their device: the same fields with the same defaults in both.
+struct ActorCriticNetworkConfig {
+  std::vector<int> hidden_sizes{256, 256};  // actor and critic MLP hidden layers
+  int image_features = 16;               // CNN output size (paper: 16)
+  int image_fc_size = 256;               // the CNN's hidden FC layer
+  bool share_encoder = true;             // actor uses the critic encoder's features (detached)
+  ImageStorage image_storage = ImageStorage::kUint8;  // replay images: uint8 or float16
+  std::string device = "cpu";            // torch device of nets and batches
+};
+
+struct Td3Config : ActorCriticNetworkConfig {
   double gamma = 0.99;                   // discount per environment step
   double actor_learning_rate = 3e-4;     // Adam step size of the actor
   double critic_learning_rate = 3e-4;    // Adam step size of the critics (+ encoder)
@@ -140,17 +152,11 @@ struct Td3Config {
   // bc_decay_updates actor updates (0 = constant). bc_weight 0 = plain TD3.
   double bc_weight = 0;
   std::int64_t bc_decay_updates = 0;
-  std::vector<int> hidden_sizes{256, 256};  // actor and critic MLP hidden layers
-  int image_features = 16;               // CNN output size (paper: 16)
-  int image_fc_size = 256;               // the CNN's hidden FC layer
-  bool share_encoder = true;             // actor uses the critic encoder's features (detached)
-  ImageStorage image_storage = ImageStorage::kUint8;  // replay images: uint8 or float16
-  std::string device = "cpu";            // torch device of nets and batches
 
   static Td3Config from_yaml(const YAML::Node& node, const std::string& source);
 };
 
-struct SacConfig {
+struct SacConfig : ActorCriticNetworkConfig {
   double gamma = 0.99;                   // discount per environment step
   double actor_learning_rate = 3e-4;     // Adam step size of the actor
   double critic_learning_rate = 1e-3;    // Adam step size of the critics (+ encoder)
@@ -171,12 +177,6 @@ struct SacConfig {
   double log_std_min = -5.0;             // actor log-std range
   double log_std_max = 2.0;
   double max_grad_norm = 0;              // clip gradient L2 norms; 0 = off
-  std::vector<int> hidden_sizes{256, 256};  // actor and critic MLP hidden layers
-  int image_features = 16;               // CNN output size
-  int image_fc_size = 256;               // the CNN's hidden FC layer
-  bool share_encoder = true;             // actor uses the critic encoder's features (detached)
-  ImageStorage image_storage = ImageStorage::kUint8;  // replay images: uint8 or float16
-  std::string device = "cpu";            // torch device of nets and batches
 
   static SacConfig from_yaml(const YAML::Node& node, const std::string& source);
 };
