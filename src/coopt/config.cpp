@@ -11,6 +11,12 @@
 namespace comorph::coopt {
 namespace {
 
+// The largest count of episodes a config may give, also as the interval
+// between two episode events (evaluations, checkpoints, pilot episodes, ...).
+constexpr int kMaxEpisodes = 10000000;
+// The largest seed a config may give (seeds are ints: this stays below 2^31 - 1).
+constexpr int kMaxSeed = 2000000000;
+
 [[noreturn]] void fail(const std::string& source, const std::string& key, const std::string& what) {
   throw std::runtime_error(source + ": field '" + quote_value(key) + "': " + what);
 }
@@ -73,9 +79,9 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   f.add(pre + ".mode", &p.mode);
   f.add(pre + ".fixed_modules", &p.fixed_modules, kMinModules, kMaxModules);
   f.add(pre + ".motion_algo", &p.motion_algo);
-  f.add(pre + ".seed", &p.seed, 0, 2000000000);
-  f.add(pre + ".warmup_episodes", &p.warmup_episodes, 0, 10000000);
-  f.add(pre + ".episodes", &p.episodes, 0, 10000000);
+  f.add(pre + ".seed", &p.seed, 0, kMaxSeed);
+  f.add(pre + ".warmup_episodes", &p.warmup_episodes, 0, kMaxEpisodes);
+  f.add(pre + ".episodes", &p.episodes, 0, kMaxEpisodes);
   f.add(pre + ".sync_interval", &p.sync_interval, 1, 100000);
   f.add(pre + ".learner_thread", &p.learner_thread);
   f.add(pre + ".torch_threads", &p.torch_threads, 1, 64);
@@ -86,25 +92,25 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   f.add(pre + ".decision_camera", &p.decision_camera);
   f.add(pre + ".warmup_policy", &p.warmup_policy);
   f.add(pre + ".warmup_noise", &p.warmup_noise, 0.0, 2.0);
-  f.add(pre + ".scripted_interval", &p.scripted_interval, 0, 10000000);
+  f.add(pre + ".scripted_interval", &p.scripted_interval, 0, kMaxEpisodes);
   f.add(pre + ".pilot_random_configs", &p.pilot_random_configs);
   f.add(pre + ".pilot_gait_per_modules", &p.pilot_gait_per_modules);
   f.add(pre + ".pilot_flat_steering", &p.pilot_flat_steering);
   f.add(pre + ".pilot_stair_steering", &p.pilot_stair_steering);
   f.add(pre + ".pilot_labels", &p.pilot_labels);
-  f.add(pre + ".greedy_motion_interval", &p.greedy_motion_interval, 0, 10000000);
+  f.add(pre + ".greedy_motion_interval", &p.greedy_motion_interval, 0, kMaxEpisodes);
   f.add(pre + ".config_learns_from", &p.config_learns_from);
   f.add(pre + ".config_target", &p.config_target);
-  f.add(pre + ".config_refit_episodes", &p.config_refit_episodes, 0, 10000000);
+  f.add(pre + ".config_refit_episodes", &p.config_refit_episodes, 0, kMaxEpisodes);
   f.add(pre + ".scene_source", &p.scene_source);
   f.add(pre + ".classifier_dir", &p.classifier_dir);
   f.add(pre + ".scenario", &p.scenario);
   f.add(pre + ".stair_height", &p.stair_height, 0, 0.5);
-  f.add(pre + ".eval_interval", &p.eval_interval, 0, 10000000);
+  f.add(pre + ".eval_interval", &p.eval_interval, 0, kMaxEpisodes);
   f.add(pre + ".eval_episodes", &p.eval_episodes, 1, 100000);
-  f.add(pre + ".eval_seed", &p.eval_seed, 0, 2000000000);
-  f.add(pre + ".checkpoint_interval", &p.checkpoint_interval, 1, 10000000);
-  f.add(pre + ".progress_interval", &p.progress_interval, 1, 10000000);
+  f.add(pre + ".eval_seed", &p.eval_seed, 0, kMaxSeed);
+  f.add(pre + ".checkpoint_interval", &p.checkpoint_interval, 1, kMaxEpisodes);
+  f.add(pre + ".progress_interval", &p.progress_interval, 1, kMaxEpisodes);
   f.add(pre + ".env_dir", &p.env_dir);
   f.apply(n, pre + ".");
   if (!rl::has_learner(p.motion_algo) || rl::learner_entry(p.motion_algo).actions != rl::ActionKind::kContinuous) {
@@ -135,7 +141,7 @@ EvalParams read_eval(const YAML::Node& n, const std::string& source) {
   EvalParams p;
   YamlFields f(source);
   f.add("eval.episodes", &p.episodes, 1, 1000000);
-  f.add("eval.seed", &p.seed, 0, 2000000000);
+  f.add("eval.seed", &p.seed, 0, kMaxSeed);
   f.add("eval.workers", &p.workers, 0, 256);
   f.apply(n, "eval.");
   return p;
