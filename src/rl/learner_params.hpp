@@ -68,7 +68,6 @@ void check_shared_learner_fields(const YamlFields& f, const LearnerConfig& c) {
 enum class ImageStorage { kUint8, kFloat16 };
 enum class DqnLoss { huber, mse };                    // DQN's loss on the TD error: smooth L1 (delta 1) or squared
 enum class DiscountPer { step, decision };            // what DQN's gamma discounts
-enum class NoiseDecayUnit { transitions, episodes };  // what TD3's exploration-noise decay counts
 constexpr auto enum_names(ImageStorage) {
   return std::array{EnumName{ImageStorage::kUint8, "uint8"}, EnumName{ImageStorage::kFloat16, "float16"}};
 }
@@ -77,10 +76,6 @@ constexpr auto enum_names(DqnLoss) {
 }
 constexpr auto enum_names(DiscountPer) {
   return std::array{EnumName{DiscountPer::step, "step"}, EnumName{DiscountPer::decision, "decision"}};
-}
-constexpr auto enum_names(NoiseDecayUnit) {
-  return std::array{EnumName{NoiseDecayUnit::transitions, "transitions"},
-                    EnumName{NoiseDecayUnit::episodes, "episodes"}};
 }
 
 struct DqnConfig {
@@ -125,6 +120,13 @@ struct ActorCriticNetworkConfig {
   ImageStorage image_storage = ImageStorage::kUint8;  // replay images: uint8 or float16
   std::string device = "cpu";            // torch device of nets and batches
 };
+
+// What TD3's exploration-noise decay counts (its only user, Td3Config, follows).
+enum class NoiseDecayUnit { transitions, episodes };
+constexpr auto enum_names(NoiseDecayUnit) {
+  return std::array{EnumName{NoiseDecayUnit::transitions, "transitions"},
+                    EnumName{NoiseDecayUnit::episodes, "episodes"}};
+}
 
 struct Td3Config : ActorCriticNetworkConfig {
   double gamma = 0.99;                   // discount per environment step
