@@ -96,6 +96,7 @@ int main(int argc, char** argv) {
   app.add_option("--image-size", image_size, "depth image side, pixels")->capture_default_str();
   app.add_option("--vector-size", vector_size, "robot-state vector length")->capture_default_str();
   app.add_option("--batch", batch, "update batch size")->capture_default_str();
+  app.add_option("--action-dims", action_dims, "continuous action dimensions")->capture_default_str();
   app.add_option("--threads", threads, "torch intra-op threads")->capture_default_str();
   app.add_option("--min-seconds", min_seconds, "time per measurement, s")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
@@ -115,21 +116,26 @@ int main(int argc, char** argv) {
   const rl::ActionSpec cont{rl::ActionKind::kContinuous, action_dims};
 
   // TD3 (vector observation) at three widths: the smaller the networks, the
-  // larger the share of per-operation overhead (ratio) in an update.
+  // larger the share of per-operation overhead (ratio) in an update. Each
+  // width twice: the explicit passes the learner takes (rl/mlp_pass.hpp) and
+  // autograd, which computes the same numbers.
   for (int width : {64, 128, 256}) {
-    rl::Td3Config c;
-    c.batch_size = batch;
-    c.hidden_sizes = {width, width};
-    rl::Td3 td3(vec_spec, action_dims, c, 1);
-    fill(td3, vec_spec, cont, 2000);
-    const double Fa = td3.networks()->actor->forward_flops();
-    const double Fc = td3.networks()->critic1->forward_flops();
-    // target actor + 2 target critics; 2 critics fwd+bwd; actor step (actor fwd+bwd,
-    // critic fwd+bwd) every policy_delay updates.
-    const double flops = batch * (Fa + 2 * Fc + 6 * Fc + (3 * Fa + 3 * Fc) / c.policy_delay);
-    print_row({fmt::format("TD3 update (vector obs), {} wide", width),
-               seconds_per_call([&] { td3.update(); }, min_seconds), flops},
-              s_per_flop);
+    for (const bool autograd : {false, true}) {
+      rl::Td3Config c;
+      c.batch_size = batch;
+      c.hidden_sizes = {width, width};
+      rl::Td3 td3(vec_spec, action_dims, c, 1);
+      td3.force_autograd(autograd);
+      fill(td3, vec_spec, cont, 2000);
+      const double Fa = td3.networks()->actor->forward_flops();
+      const double Fc = td3.networks()->critic1->forward_flops();
+      // target actor + 2 target critics; 2 critics fwd+bwd; actor step (actor fwd+bwd,
+      // critic fwd+bwd) every policy_delay updates.
+      const double flops = batch * (Fa + 2 * Fc + 6 * Fc + (3 * Fa + 3 * Fc) / c.policy_delay);
+      print_row({fmt::format("TD3 update (vector obs), {} wide, {}", width, autograd ? "autograd" : "explicit"),
+                 seconds_per_call([&] { td3.update(); }, min_seconds), flops},
+                s_per_flop);
+    }
   }
   // SAC (vector observation).
   {

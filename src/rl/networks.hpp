@@ -46,6 +46,7 @@ class MlpImpl : public torch::nn::Module {
   MlpImpl(int input_size, const std::vector<int>& hidden_sizes, int output_size);
   torch::Tensor forward(torch::Tensor x);
   double forward_flops() const;  // per sample
+  const std::vector<torch::nn::Linear>& layers() const { return layers_; }
 
  private:
   std::vector<torch::nn::Linear> layers_;

@@ -19,6 +19,10 @@ torch::Tensor gaussian_noise(std::int64_t rows, std::int64_t cols, double std, s
 void gradient_step(FlatAdam& optimizer, const torch::Tensor& loss, double max_grad_norm) {
   optimizer.zero_grad();
   loss.backward();
+  clip_and_step(optimizer, max_grad_norm);
+}
+
+void clip_and_step(FlatAdam& optimizer, double max_grad_norm) {
   if (max_grad_norm > 0) optimizer.clip_grad_norm(max_grad_norm);
   optimizer.step();
 }

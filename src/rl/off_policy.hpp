@@ -54,6 +54,8 @@ bool act_continuous(const Config& c, int action_dims, const LearnerCounters& cou
 // One gradient step: zero_grad, backward, the gradient's L2 norm clipped to
 // max_grad_norm (0: not clipped), step; over the optimizer's own parameters.
 void gradient_step(FlatAdam& optimizer, const torch::Tensor& loss, double max_grad_norm);
+// Its second half, once the gradient is in the optimizer's buffer: clip, step.
+void clip_and_step(FlatAdam& optimizer, double max_grad_norm);
 
 // The twin critics' step of TD3 and SAC towards the targets y: MSE of Q1 and
 // Q2 at the batch's actions, one gradient_step. The critic encoder runs once

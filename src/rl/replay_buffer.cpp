@@ -133,14 +133,61 @@ ReplayBatch ReplayBuffer::gather(const torch::Tensor& slots, const torch::Device
   return b;
 }
 
+namespace {
+
+// Slots drawn uniformly with replacement from the first `size`.
+void draw_slots(torch::Tensor& slots, std::int64_t size, std::mt19937_64& rng) {
+  if (size == 0) throw std::logic_error("ReplayBuffer::sample: buffer is empty");
+  std::int64_t* s = slots.data_ptr<std::int64_t>();
+  std::uniform_int_distribution<std::int64_t> pick(0, size - 1);
+  for (std::int64_t i = 0; i < slots.numel(); ++i) s[i] = pick(rng);
+}
+
+}  // namespace
+
 ReplayBatch ReplayBuffer::sample(std::int64_t batch_size, std::mt19937_64& rng,
                                  const torch::Device& device) const {
-  if (size_ == 0) throw std::logic_error("ReplayBuffer::sample: buffer is empty");
   torch::Tensor slots = torch::empty({batch_size}, torch::TensorOptions().dtype(torch::kInt64));
-  std::int64_t* s = slots.data_ptr<std::int64_t>();
-  std::uniform_int_distribution<std::int64_t> pick(0, size_ - 1);
-  for (std::int64_t i = 0; i < batch_size; ++i) s[i] = pick(rng);
+  draw_slots(slots, size_, rng);
   return gather(slots, device);
+}
+
+void ReplayBuffer::sample_into(ReplayBatch& b, std::int64_t batch_size, std::mt19937_64& rng,
+                               const torch::Device& device) const {
+  if (obs_spec_.has_image() || !device.is_cpu()) {
+    b = sample(batch_size, rng, device);
+    return;
+  }
+  if (!b.slots.defined() || b.slots.size(0) != batch_size) {
+    b = ReplayBatch{};
+    b.slots = torch::empty({batch_size}, torch::TensorOptions().dtype(torch::kInt64));
+    const auto like = [&](const torch::Tensor& storage) {
+      std::vector<std::int64_t> shape = storage.sizes().vec();
+      shape[0] = batch_size;
+      return torch::empty(shape, storage.options());
+    };
+    b.vector = like(vector_);
+    b.next_vector = like(next_vector_);
+    b.action = like(action_);
+    b.reward = like(reward_);
+    b.bootstrap = like(discount_);
+    if (next_valid_.defined()) b.next_valid_actions = like(next_valid_);
+    if (target_.defined()) b.target = like(target_);
+    b.has_target = like(has_target_);
+  }
+  draw_slots(b.slots, size_, rng);
+  const torch::Tensor& slots = b.slots;
+  at::index_select_out(b.vector, vector_, 0, slots);
+  at::index_select_out(b.next_vector, next_vector_, 0, slots);
+  at::index_select_out(b.action, action_, 0, slots);
+  at::index_select_out(b.reward, reward_, 0, slots);
+  // discount * (1 - terminated), as gather() computes it.
+  at::index_select_out(b.bootstrap, terminated_, 0, slots);
+  at::rsub_out(b.bootstrap, b.bootstrap, 1.0f);
+  b.bootstrap.mul_(discount_.index_select(0, slots));
+  if (next_valid_.defined()) at::index_select_out(b.next_valid_actions, next_valid_, 0, slots);
+  if (target_.defined()) at::index_select_out(b.target, target_, 0, slots);
+  at::index_select_out(b.has_target, has_target_, 0, slots);
 }
 
 void ReplayBuffer::save(torch::serialize::OutputArchive& a) const {

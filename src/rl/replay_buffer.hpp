@@ -34,6 +34,7 @@ struct ReplayBatch {
   torch::Tensor next_valid_actions;          // [B, n] bool (discrete), or undefined
   torch::Tensor target;                      // [B, A] float32: the demonstrator's action (continuous), 0 where none
   torch::Tensor has_target;                  // [B] float32: 1 where the transition has a target
+  torch::Tensor slots;                       // [B] int64: the slots they came from (sample_into)
 };
 
 class ReplayBuffer {
@@ -49,6 +50,12 @@ class ReplayBuffer {
   // `batch_size` transitions drawn uniformly with replacement by `rng`.
   ReplayBatch sample(std::int64_t batch_size, std::mt19937_64& rng,
                      const torch::Device& device) const;
+  // As sample(), into `batch`, whose tensors are allocated at the first call
+  // and reused after (a learner's update then allocates no batch). For a
+  // vector observation on the CPU; otherwise it assigns sample()'s batch.
+  // The same draws from `rng`, the same values.
+  void sample_into(ReplayBatch& batch, std::int64_t batch_size, std::mt19937_64& rng,
+                   const torch::Device& device) const;
   // The transitions at the given slots (tests, debugging).
   ReplayBatch gather(const torch::Tensor& slots, const torch::Device& device) const;
 

@@ -58,11 +58,17 @@ void Td3::act(const Observation& o, bool explore, Action& action) {
 }
 
 void Td3::update() {
-  const ReplayBatch b = replay_.sample(config_.batch_size, rng_, device_);
+  replay_.sample_into(batch_, config_.batch_size, rng_, device_);
   const torch::Tensor smoothing =
       gaussian_noise(config_.batch_size, action_dims_, config_.policy_noise, rng_, device_)
           .clamp(-config_.noise_clip, config_.noise_clip);
+  if (spec_.has_image() || force_autograd_)
+    update_with_autograd(batch_, smoothing);
+  else
+    update_with_explicit_passes(batch_, smoothing);
+}
 
+void Td3::update_with_autograd(const ReplayBatch& b, const torch::Tensor& smoothing) {
   // Critic target: r + gamma^k (1 - terminated) min(Q1', Q2')(s', pi'(s') + clipped noise).
   torch::Tensor y;
   {
@@ -95,9 +101,79 @@ void Td3::update() {
       actor_loss = -q.mean();
     }
     gradient_step(*actor_optimizer_, actor_loss, config_.max_grad_norm);
-    soft_update(target_actor_, actor_optimizer_->parameters(), config_.tau);
-    soft_update(target_critic_, critic_optimizer_->parameters(), config_.tau);
+    actor_step_done();
   }
+}
+
+// The update above, pass by pass: each gradient is the one autograd computes
+// for the same loss, with the same operations (rl/mlp_pass.hpp). The
+// observation is the vector alone, so the critics' features are b.vector.
+void Td3::update_with_explicit_passes(const ReplayBatch& b, const torch::Tensor& smoothing) {
+  torch::NoGradGuard no_grad;
+  const std::int64_t batch = config_.batch_size, obs = spec_.vector_size, act = action_dims_;
+  if (!explicit_) {
+    const auto options = b.reward.options();
+    explicit_ = std::make_unique<ExplicitUpdate>(ExplicitUpdate{
+        MlpPass(nets_->actor, batch), MlpPass(nets_->critic1, batch), torch::empty({batch, obs + act}, options),
+        torch::empty({batch}, options), torch::empty({batch}, options), torch::empty({batch, act}, options),
+        torch::empty({batch, act}, options), torch::empty({batch, act}, options), torch::ones({}, options)});
+  }
+  ExplicitUpdate& e = *explicit_;
+  const auto critic_input_of = [&](const torch::Tensor& observation, const torch::Tensor& action) {
+    e.critic_input.narrow(1, 0, obs).copy_(observation);
+    e.critic_input.narrow(1, obs, act).copy_(action);
+    return e.critic_input;
+  };
+  const auto q_of = [&](Mlp& critic) { return e.critic.forward(critic, e.critic_input).view({batch}); };
+
+  // Critic target: r + gamma^k (1 - terminated) min(Q1', Q2')(s', pi'(s') + clipped noise).
+  const torch::Tensor& next_a = e.actor.forward(target_->actor, b.next_vector);
+  next_a.tanh_().add_(smoothing).clamp_(-1.0, 1.0);
+  critic_input_of(b.next_vector, next_a);
+  e.y.copy_(q_of(target_->critic1));
+  at::minimum_out(e.y, e.y, q_of(target_->critic2));
+  e.y.mul_(b.bootstrap).add_(b.reward);
+
+  // Twin critics: MSE to y each; their parameters are disjoint, so one after the other.
+  critic_input_of(b.vector, b.action);
+  torch::Tensor loss;
+  for (Mlp* critic : {&nets_->critic1, &nets_->critic2}) {
+    const torch::Tensor q = q_of(*critic);
+    loss = loss.defined() ? loss + torch::mse_loss(q, e.y) : torch::mse_loss(q, e.y);
+    at::mse_loss_backward_out(e.q_grad, e.one, q, e.y, at::Reduction::Mean);
+    e.critic.backward(e.q_grad.view({batch, 1}), /*parameter_grads=*/true, /*input_grad=*/false);
+  }
+  clip_and_step(*critic_optimizer_, config_.max_grad_norm);
+  last_loss_ = loss.item<double>();
+  ++counters_.updates;
+  if (counters_.updates % config_.policy_delay != 0) return;
+
+  // Delayed actor update: maximise Q1(s, pi(s)) (+ behaviour cloning).
+  const torch::Tensor& pi = e.actor.forward(nets_->actor, b.vector);
+  pi.tanh_();
+  critic_input_of(b.vector, pi);
+  const torch::Tensor q = q_of(nets_->critic1);
+  // d loss / d q of -mean(q) [/ mean|q|], in autograd's order: divide, negate, spread over the batch.
+  const double w = config_.bc_weight > 0 ? bc_weight_now() : 0.0;
+  const torch::Tensor d_mean = config_.bc_weight > 0 ? (e.one / q.abs().mean().clamp_min(1e-6)).neg() : -e.one;
+  e.q_grad.copy_(d_mean.expand({batch})).div_(batch);
+  e.critic.backward(e.q_grad.view({batch, 1}), /*parameter_grads=*/false, /*input_grad=*/true);
+  torch::Tensor d_pi = e.critic.input_grad().narrow(1, obs, act);
+  if (w > 0) {
+    // w * mean(sum_j (pi - target)^2 * has_target): (w / B * has_target) * 2 (pi - target).
+    e.bc_grad.copy_(pi).sub_(b.target).mul_(2.0);
+    e.bc_grad.mul_((e.one * w).expand({batch}).div(batch).mul(b.has_target).unsqueeze(1));
+    d_pi = at::add_out(e.pi_grad, d_pi, e.bc_grad);
+  }
+  at::tanh_backward_out(e.actor_output_grad, d_pi, pi);
+  e.actor.backward(e.actor_output_grad, /*parameter_grads=*/true, /*input_grad=*/false);
+  clip_and_step(*actor_optimizer_, config_.max_grad_norm);
+  actor_step_done();
+}
+
+void Td3::actor_step_done() {
+  soft_update(target_actor_, actor_optimizer_->parameters(), config_.tau);
+  soft_update(target_critic_, critic_optimizer_->parameters(), config_.tau);
 }
 
 Td3::CheckpointParts Td3::checkpoint_parts() const {

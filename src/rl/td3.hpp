@@ -12,6 +12,7 @@
 
 #include <memory>
 
+#include "rl/mlp_pass.hpp"
 #include "rl/networks.hpp"
 #include "rl/off_policy.hpp"
 #include "rl/policy.hpp"
@@ -33,6 +34,10 @@ class Td3 final : public OffPolicyLearner {
   double bc_weight_now() const;  // w of the behaviour-cloning term at the current update
   const Td3Config& config() const { return config_; }
   ActorCritic& networks() { return nets_; }
+  // A vector observation's update runs on explicit passes (rl/mlp_pass.hpp),
+  // an image's on autograd (the convolutions). Both give the same numbers;
+  // forcing autograd is for comparing them (a test) and timing them (bench_rl).
+  void force_autograd(bool on) { force_autograd_ = on; }
 
  protected:
   torch::nn::Module& acting_module() const override { return *nets_.ptr(); }
@@ -45,6 +50,21 @@ class Td3 final : public OffPolicyLearner {
   std::unique_ptr<FlatAdam> actor_optimizer_, critic_optimizer_;  // over nets_'s actor and critic parameters
   // The target networks' actor and critic parameters, laid out as the optimizers' (one Polyak step each).
   mutable FlatParameters target_actor_, target_critic_;
+
+  // Buffers of the explicit update, built at its first use.
+  struct ExplicitUpdate {
+    MlpPass actor, critic;       // any actor / critic network (online or target)
+    torch::Tensor critic_input;  // [B, observation + action]: the critics' cat
+    torch::Tensor y, q_grad;     // [B]
+    torch::Tensor bc_grad, pi_grad, actor_output_grad;  // [B, A]
+    torch::Tensor one;           // 0-dim 1: d loss / d loss
+  };
+  std::unique_ptr<ExplicitUpdate> explicit_;
+  ReplayBatch batch_;  // reused by each update (ReplayBuffer::sample_into)
+  bool force_autograd_ = false;
+  void update_with_autograd(const ReplayBatch& b, const torch::Tensor& smoothing);
+  void update_with_explicit_passes(const ReplayBatch& b, const torch::Tensor& smoothing);
+  void actor_step_done();  // the Polyak steps after an actor step
 };
 
 }  // namespace comorph::rl

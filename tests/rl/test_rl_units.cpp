@@ -522,6 +522,111 @@ TEST(Td3, BehaviourCloningPullsTheActorToTheDemonstratedActions) {
   EXPECT_GT(without, 0.2);
 }
 
+// TD3's explicit passes (rl/mlp_pass.hpp) compute what autograd computes,
+// bit for bit: two learners of one seed, one forced onto autograd, train on the
+// same transitions and end with equal networks, targets, optimizer states and
+// losses. With and without behaviour cloning (decaying, so that its weight
+// reaches 0), clipping, a batch that is not a power of two, two layers and one.
+// Every tensor of `a` equals the one under the same key of `b`, in nested archives too.
+void expect_equal_archives(torch::serialize::InputArchive& a, torch::serialize::InputArchive& b,
+                           const std::string& prefix, int& compared) {
+  for (const std::string& key : a.keys()) {
+    torch::Tensor ta, tb;
+    torch::serialize::InputArchive sa, sb;
+    if (a.try_read(key, ta)) {
+      ASSERT_TRUE(b.try_read(key, tb)) << prefix << key;
+      EXPECT_TRUE(torch::equal(ta, tb)) << prefix << key;
+      ++compared;
+    } else if (a.try_read(key, sa)) {
+      ASSERT_TRUE(b.try_read(key, sb)) << prefix << key;
+      expect_equal_archives(sa, sb, prefix + key + "/", compared);
+    }
+  }
+}
+
+struct ExplicitPassCase {
+  double bc_weight;
+  double max_grad_norm;
+  std::vector<int> hidden;
+};
+
+class Td3ExplicitPasses : public ::testing::TestWithParam<ExplicitPassCase> {};
+
+TEST_P(Td3ExplicitPasses, EqualAutogradBitForBit) {
+  rl::Td3Config c;
+  c.hidden_sizes = GetParam().hidden;
+  c.batch_size = 37;
+  c.buffer_size = 500;
+  c.learning_starts = 0;
+  c.random_action_steps = 0;
+  c.bc_weight = GetParam().bc_weight;
+  c.bc_decay_updates = 150;
+  c.max_grad_norm = GetParam().max_grad_norm;
+  c.actor_learning_rate = c.critic_learning_rate = 3e-3;
+  rl::Td3 explicit_passes({0, 0, 0, 3}, 2, c, 5), autograd({0, 0, 0, 3}, 2, c, 5);
+  autograd.force_autograd(true);
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  rl::Action a;
+  for (int i = 0; i < 300; ++i) {
+    a.continuous = {u(rng), u(rng)};
+    a.target.clear();
+    if (i % 3 == 0) a.target = {u(rng), u(rng)};
+    const rl::Observation o = vector_obs({u(rng), u(rng), u(rng)}), next = vector_obs({u(rng), u(rng), u(rng)});
+    const float reward = u(rng);
+    for (rl::Td3* t : {&explicit_passes, &autograd}) t->store(o, a, reward, next, i % 7 == 0, false);
+  }
+  for (int update = 0; update < 200; ++update) {
+    explicit_passes.update();
+    autograd.update();
+    ASSERT_EQ(explicit_passes.last_loss(), autograd.last_loss()) << "update " << update;
+  }
+  const std::string path_e = temp_path("td3_explicit.pt"), path_a = temp_path("td3_autograd.pt");
+  explicit_passes.save_without_replay(path_e);
+  autograd.save_without_replay(path_a);
+  torch::serialize::InputArchive ae, aa;
+  ae.load_from(path_e);
+  aa.load_from(path_a);
+  int compared = 0;
+  expect_equal_archives(ae, aa, "", compared);
+  EXPECT_GT(compared, 20);
+  std::filesystem::remove(path_e);
+  std::filesystem::remove(path_a);
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, Td3ExplicitPasses,
+                         ::testing::Values(ExplicitPassCase{0.0, 0.0, {16, 16}}, ExplicitPassCase{2.5, 0.0, {16, 16}},
+                                           ExplicitPassCase{2.5, 1.0, {16, 16}}, ExplicitPassCase{0.0, 0.5, {8}}));
+
+// sample_into reuses its batch's tensors and returns what sample() returns
+// for the same draws, terminated transitions and targets included.
+TEST(ReplayBuffer, SampleIntoEqualsSample) {
+  rl::ReplayBuffer buffer({0, 0, 0, 2}, {rl::ActionKind::kContinuous, 2}, 50);
+  rl::Action a;
+  for (int i = 0; i < 40; ++i) {
+    a.continuous = {0.1f * i, -0.2f * i};
+    a.target.clear();
+    if (i % 3 == 0) a.target = {0.5f, -0.5f};
+    buffer.add(vector_obs({float(i), 1.0f}), a, 0.25f * i, vector_obs({float(i + 1), 2.0f}), i % 4 == 0, 0.9f);
+  }
+  std::mt19937_64 rng_a(3), rng_b(3);
+  rl::ReplayBatch into;
+  for (int round = 0; round < 3; ++round) {
+    const rl::ReplayBatch expected = buffer.sample(16, rng_a, torch::kCPU);
+    const void* storage = into.vector.defined() ? into.vector.data_ptr() : nullptr;
+    buffer.sample_into(into, 16, rng_b, torch::kCPU);
+    if (storage) {
+      EXPECT_EQ(into.vector.data_ptr(), storage);  // reused, not reallocated
+    }
+    for (const auto& [e, got] : {std::pair{expected.vector, into.vector}, {expected.next_vector, into.next_vector},
+                                 {expected.action, into.action}, {expected.reward, into.reward},
+                                 {expected.bootstrap, into.bootstrap}, {expected.target, into.target},
+                                 {expected.has_target, into.has_target}})
+      EXPECT_TRUE(torch::equal(e, got));
+  }
+  EXPECT_GT(into.bootstrap.eq(0).sum().item<int>(), 0);  // some drawn transitions were terminated
+}
+
 TEST(ReplayBuffer, KeepsBehaviourCloningTargetsThroughSaveAndLoad) {
   rl::ReplayBuffer buffer({0, 0, 0, 1}, {rl::ActionKind::kContinuous, 1}, 4);
   rl::Action a;
