@@ -119,23 +119,23 @@ void Td3::update_with_explicit_passes(const ReplayBatch& b, const torch::Tensor&
         torch::empty({batch, act}, options), torch::empty({batch, act}, options), torch::ones({}, options)});
   }
   ExplicitUpdate& e = *explicit_;
-  const auto critic_input_of = [&](const torch::Tensor& observation, const torch::Tensor& action) {
+  // The critics' input cat({observation, action}, 1), in the one buffer.
+  const auto set_critic_input = [&](const torch::Tensor& observation, const torch::Tensor& action) {
     e.critic_input.narrow(1, 0, obs).copy_(observation);
     e.critic_input.narrow(1, obs, act).copy_(action);
-    return e.critic_input;
   };
   const auto q_of = [&](Mlp& critic) { return e.critic.forward(critic, e.critic_input).view({batch}); };
 
   // Critic target: r + gamma^k (1 - terminated) min(Q1', Q2')(s', pi'(s') + clipped noise).
   const torch::Tensor& next_a = e.actor.forward(target_->actor, b.next_vector);
   next_a.tanh_().add_(smoothing).clamp_(-1.0, 1.0);
-  critic_input_of(b.next_vector, next_a);
+  set_critic_input(b.next_vector, next_a);
   e.y.copy_(q_of(target_->critic1));
   at::minimum_out(e.y, e.y, q_of(target_->critic2));
   e.y.mul_(b.bootstrap).add_(b.reward);
 
   // Twin critics: MSE to y each; their parameters are disjoint, so one after the other.
-  critic_input_of(b.vector, b.action);
+  set_critic_input(b.vector, b.action);
   torch::Tensor loss;
   for (Mlp* critic : {&nets_->critic1, &nets_->critic2}) {
     const torch::Tensor q = q_of(*critic);
@@ -151,7 +151,7 @@ void Td3::update_with_explicit_passes(const ReplayBatch& b, const torch::Tensor&
   // Delayed actor update: maximise Q1(s, pi(s)) (+ behaviour cloning).
   const torch::Tensor& pi = e.actor.forward(nets_->actor, b.vector);
   pi.tanh_();
-  critic_input_of(b.vector, pi);
+  set_critic_input(b.vector, pi);
   const torch::Tensor q = q_of(nets_->critic1);
   // d loss / d q of -mean(q) [/ mean|q|], in autograd's order: divide, negate, spread over the batch.
   const double w = config_.bc_weight > 0 ? bc_weight_now() : 0.0;
