@@ -109,7 +109,7 @@ void Td3::update_with_autograd(const ReplayBatch& b, const torch::Tensor& smooth
 // for the same loss, with the same operations (rl/mlp_pass.hpp). The
 // observation is the vector alone, so the critics' features are b.vector.
 void Td3::update_with_explicit_passes(const ReplayBatch& b, const torch::Tensor& smoothing) {
-  torch::NoGradGuard no_grad;
+  c10::InferenceMode no_autograd;  // nothing here is differentiated: skip autograd's dispatch too
   const std::int64_t batch = config_.batch_size, obs = spec_.vector_size, act = action_dims_;
   if (!explicit_) {
     const auto options = b.reward.options();
