@@ -85,6 +85,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   f.add(pre + ".sync_interval", &p.sync_interval, 1, 100000);
   f.add(pre + ".learner_thread", &p.learner_thread);
   f.add(pre + ".torch_threads", &p.torch_threads, 1, 64);
+  f.add(pre + ".simulation_threads", &p.simulation_threads, 1, 64);
   f.add(pre + ".motion_image", &p.motion_image);
   f.add(pre + ".config_vector", &p.config_vector);
   f.add(pre + ".motion_clearance", &p.motion_clearance);

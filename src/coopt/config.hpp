@@ -70,6 +70,14 @@ struct TrainerParams {
   int sync_interval = 64;             // control steps between hand-overs (the acting policy lags by <= 2 of these)
   bool learner_thread = true;         // false: run the updates inline (one core, same results)
   int torch_threads = 1;              // torch intra-op threads per thread (1: small nets, reproducible)
+  // Simulation threads, each with its own env, scene source, pilot and acting
+  // copies of both models, feeding the one learner (coopt/simulation_threads.cpp).
+  // 1: the single acting thread above. N > 1: they step in rounds of
+  // sync_interval control steps (a thread whose episode ends waits for the
+  // round's end), the round's transitions go to the learner in thread order,
+  // and every episode draws from its own random streams; so a (seed, N) pair
+  // gives the same results every time, but not those of another N.
+  int simulation_threads = 1;
   bool motion_image = true;           // the motion model sees the depth image (CNN) + state; false: state only
   bool motion_clearance = false;      // the motion model also sees task's clearance(): nearest depth per image column
   bool normalize_state = false;       // scale the state vector's fields to about [-1, 1] (fixed factors, trainer.cpp)

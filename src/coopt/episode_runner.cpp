@@ -167,7 +167,7 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
   SceneSource& scene = scene_;
   Buffers& b = b_;
   EpisodeLog log;
-  const bool hierarchical = agent.config != nullptr;
+  const bool hierarchical = agent.hierarchical();
   const TrainerParams& t = c.trainer;
   Configuration configuration = make_chain(c.trainer.fixed_modules);
   double return_r2 = 0;
@@ -179,7 +179,7 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
   auto choose = [&](rl::Observation& o) -> const Configuration& {
     int a = hooks && hooks->random_config ? hooks->random_config(b.mask) : -1;
     if (a < 0) {
-      agent.config->act(o, explore, b.caction);
+      agent.choose_config(o, explore, b.caction);
       a = b.caction.discrete;
     }
     b.caction.discrete = a;

@@ -101,6 +101,16 @@ class SceneSource {
 struct Agent {
   std::unique_ptr<rl::Policy> motion;    // acting side of the motion model
   std::unique_ptr<rl::Learner> config;   // the DQN; nullptr in fixed mode
+  // A simulation thread's acting copy of the DQN (trainer.simulation_threads
+  // > 1), which acts instead of `config` (then nullptr) when set.
+  std::unique_ptr<rl::Policy> config_copy;
+  bool hierarchical() const { return config || config_copy; }
+  void choose_config(const rl::Observation& o, bool explore, rl::Action& a) {
+    if (config_copy)
+      config_copy->act(o, explore, a);
+    else
+      config->act(o, explore, a);
+  }
 };
 
 // Training hooks of one episode (absent for evaluation).

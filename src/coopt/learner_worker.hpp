@@ -90,6 +90,18 @@ struct Transition {
   rl::Action action;
   float reward = 0;
   bool terminated = false, truncated = false;
+  // Copies a step into this preallocated one (same sizes: no allocation).
+  void set(const rl::Observation& o, const rl::Action& a, float r, const rl::Observation& n, bool term, bool trunc) {
+    obs.image = o.image;
+    obs.vector = o.vector;
+    next.image = n.image;
+    next.vector = n.vector;
+    action.continuous = a.continuous;
+    action.target = a.target;
+    reward = r;
+    terminated = term;
+    truncated = trunc;
+  }
 };
 
 }  // namespace comorph::coopt

@@ -6,6 +6,7 @@
 #include <torch/torch.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 
@@ -19,21 +20,73 @@ namespace comorph::coopt {
 Trainer::Impl::Impl(const CooptConfig& c, const std::string& dir, TrainerCallbacks cb)
     : config(c), store(dir), callbacks(std::move(cb)), runner(config, callbacks.label_source),
       state(config) {
-  for (auto& p : pending) {
-    p.resize(c.trainer.sync_interval);
-    for (auto& t : p) {
-      rl::allocate(motion_spec(c), t.obs);
-      rl::allocate(motion_spec(c), t.next);
-      t.action.continuous.assign(control::kActionSize, 0.0f);
-    }
-  }
+  for (auto& p : pending) allocate_transitions(c, p, static_cast<std::size_t>(c.trainer.sync_interval));
   worker = std::make_unique<LearnerWorker>(c.trainer.learner_thread);
-  if (c.trainer.pilot_gait_per_modules)
+  configure_pilot(c.trainer, pilot);
+}
+
+void allocate_transitions(const CooptConfig& c, std::vector<Transition>& v, std::size_t n) {
+  v.resize(n);
+  for (Transition& t : v) {
+    rl::allocate(motion_spec(c), t.obs);
+    rl::allocate(motion_spec(c), t.next);
+    t.action.continuous.assign(control::kActionSize, 0.0f);
+    t.action.target.assign(control::kActionSize, 0.0f);  // so that copying a target does not allocate
+  }
+}
+
+void configure_pilot(const TrainerParams& t, task::ScriptedPilot& pilot) {
+  if (t.pilot_gait_per_modules)
     pilot.params() = task::searched_stair_gaits();
   else
     pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};  // the gait the physics-table search picks
-  pilot.params().flat_steering = c.trainer.pilot_flat_steering;
-  pilot.params().stair_steering = c.trainer.pilot_stair_steering;
+  pilot.params().flat_steering = t.pilot_flat_steering;
+  pilot.params().stair_steering = t.pilot_stair_steering;
+}
+
+EpisodePlan plan_episode(const TrainerParams& t, int episode) {
+  EpisodePlan p;
+  p.warmup = episode < t.warmup_episodes;
+  p.refit = episode >= t.refit_start();
+  p.scripted = !p.refit && t.warmup_policy == WarmupPolicy::scripted &&
+               (p.warmup || (t.scripted_interval > 0 && episode % t.scripted_interval == 0));
+  p.greedy_motion = p.refit || (!p.warmup && !p.scripted && t.greedy_motion_interval > 0 &&
+                                episode % t.greedy_motion_interval == 1 % t.greedy_motion_interval);
+  p.config_learns = p.refit || t.config_learns_from == ConfigLearnsFrom::all ||
+                    (t.config_learns_from == ConfigLearnsFrom::model && !p.scripted) ||
+                    (t.config_learns_from == ConfigLearnsFrom::greedy && p.greedy_motion);
+  p.random_config = p.warmup || (p.scripted && t.pilot_random_configs);
+  p.pilot = p.scripted || (t.pilot_labels && !p.refit);
+  p.spec.seed = static_cast<std::uint64_t>(t.seed) * 1000003ULL + static_cast<std::uint64_t>(episode);
+  p.spec.stair_height = t.stair_height;
+  const task::ScenarioSpec& scenario = task::scenario_spec(t.scenario);
+  p.spec.obstacles = scenario.obstacles;
+  p.spec.variant = scenario.variant;
+  return p;
+}
+
+int random_valid_action(const std::vector<std::uint8_t>& mask, std::mt19937_64& rng) {
+  int valid = 0;
+  for (auto m : mask) valid += m;
+  int k = std::uniform_int_distribution<int>(0, valid - 1)(rng);
+  for (int a = 0; a < static_cast<int>(mask.size()); ++a)
+    if (mask[a] && k-- == 0) return a;
+  return -1;
+}
+
+DecisionLog decision_log(int episode, int step, const rl::Action& a, float r2, const rl::Observation& next,
+                         bool terminated, bool truncated, int k) {
+  DecisionLog d;
+  d.episode = episode;
+  d.step = step;
+  d.modules = modules_of(a.discrete);
+  d.r2 = r2;
+  d.k = k;
+  for (int c = 0; c < kCandidates; ++c)
+    if (next.valid_actions[c]) d.next_max_modules = modules_of(c);
+  d.terminated = terminated;
+  d.truncated = truncated;
+  return d;
 }
 
 double Trainer::Impl::wall() const {
@@ -82,28 +135,34 @@ void Trainer::Impl::full_sync() {
 void Trainer::Impl::learn_episode_returns() {
   to_decision_returns(episode_decision_returns, config.dqn.gamma);
   for (std::size_t i = 0; i < episode_decisions.size(); ++i) {
-    const Transition& d = episode_decisions[i];
+    Transition& d = episode_decisions[i];
     // Terminal: no bootstrap, so the segment's length (the discount's k) plays no part.
-    state.agent.config->store(d.obs, d.action, episode_decision_returns[i], d.next, /*terminated=*/true, false);
-    for (int u = state.agent.config->updates_due(); u > 0; --u) state.agent.config->update();
+    d.reward = episode_decision_returns[i];
+    d.terminated = true;
+    d.truncated = false;
+    store_and_update(*state.agent.config, d);
   }
   episode_decisions.clear();
   episode_decision_returns.clear();
 }
 
+void store_and_update(rl::Learner& l, const Transition& t, int k) {
+  l.store(t.obs, t.action, t.reward, t.next, t.terminated, t.truncated, k);
+  for (int u = l.updates_due(); u > 0; --u) l.update();
+}
+
 EpisodeLog Trainer::Impl::train_episode() {
   const TrainerParams& t = config.trainer;
-  const bool warmup = state.episode < t.warmup_episodes;
+  const EpisodePlan plan = plan_episode(t, state.episode);
   // The DQN refit (trainer.config_refit_episodes): a fresh DQN on the frozen,
   // greedy motion model; no pilot, nothing stored for the motion learner.
-  const bool refit = state.episode >= t.refit_start();
-  if (refit && state.episode == t.refit_start()) {
+  if (plan.refit && state.episode == t.refit_start()) {
     state.agent.config = make_refit_config_model(config);
     state.config_segments = {};  // its replay starts empty: no segment of the old one to link
   }
   LearnHooks hooks;
   hooks.laps = &laps;
-  if (refit)
+  if (plan.refit)
     hooks.motion = [this](const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool) {
       ++state.steps;
     };
@@ -112,29 +171,14 @@ EpisodeLog Trainer::Impl::train_episode() {
                           bool term, bool trunc) {
       state.agent.motion->count(term, trunc);  // the acting side's exploration schedule
       Transition& tr = record ? (*record)[recorded++] : pending[filling][filled++];
-      tr.obs.image = o.image;  // same sizes: copies, no allocation
-      tr.obs.vector = o.vector;
-      tr.next.image = n.image;
-      tr.next.vector = n.vector;
-      tr.action.continuous = a.continuous;
-      tr.action.target = a.target;
-      tr.reward = r;
-      tr.terminated = term;
-      tr.truncated = trunc;
+      tr.set(o, a, r, n, term, trunc);
       ++state.steps;
       if (!record && filled == config.trainer.sync_interval) hand_over();
     };
-  const bool scripted = !refit && t.warmup_policy == WarmupPolicy::scripted &&
-                        (warmup || (t.scripted_interval > 0 && state.episode % t.scripted_interval == 0));
-  const bool greedy_motion = refit || (!warmup && !scripted && t.greedy_motion_interval > 0 &&
-                                       state.episode % t.greedy_motion_interval == 1 % t.greedy_motion_interval);
-  const bool config_learns = refit || t.config_learns_from == ConfigLearnsFrom::all ||
-                             (t.config_learns_from == ConfigLearnsFrom::model && !scripted) ||
-                             (t.config_learns_from == ConfigLearnsFrom::greedy && greedy_motion);
-  hooks.motion_greedy = greedy_motion;
-  hooks.config = [this, config_learns](const rl::Observation& o, const rl::Action& a, float r2,
-                                       const rl::Observation& n, bool term, bool trunc, int k) {
-    if (!config_learns) return;
+  hooks.motion_greedy = plan.greedy_motion;
+  hooks.config = [this, learns = plan.config_learns](const rl::Observation& o, const rl::Action& a, float r2,
+                                                     const rl::Observation& n, bool term, bool trunc, int k) {
+    if (!learns) return;
     if (config.trainer.config_target == ConfigTarget::episode_return) {
       Transition& d = episode_decisions.emplace_back();  // 2 or 3 an episode
       d.obs = o;
@@ -146,45 +190,21 @@ EpisodeLog Trainer::Impl::train_episode() {
       state.agent.config->store(o, a, r2, n, term, trunc, k);
       for (int u = state.agent.config->updates_due(); u > 0; --u) state.agent.config->update();
     }
-    if (callbacks.on_decision) {
-      DecisionLog d;
-      d.episode = state.episode;
-      d.step = runner.env().step_count();
-      d.modules = modules_of(a.discrete);
-      d.r2 = r2;
-      d.k = k;
-      for (int c = 0; c < kCandidates; ++c)
-        if (n.valid_actions[c]) d.next_max_modules = modules_of(c);
-      d.terminated = term;
-      d.truncated = trunc;
-      callbacks.on_decision(d);
-    }
+    if (callbacks.on_decision)
+      callbacks.on_decision(decision_log(state.episode, runner.env().step_count(), a, r2, n, term, trunc, k));
   };
-  if (warmup || (scripted && t.pilot_random_configs))
-    hooks.random_config = [this](const std::vector<std::uint8_t>& mask) {
-      int valid = 0;
-      for (auto m : mask) valid += m;
-      int k = std::uniform_int_distribution<int>(0, valid - 1)(state.rng);
-      for (int a = 0; a < static_cast<int>(mask.size()); ++a)
-        if (mask[a] && k-- == 0) return a;
-      return -1;
-    };
-  if (scripted || (t.pilot_labels && !refit)) {
+  if (plan.random_config)
+    hooks.random_config = [this](const std::vector<std::uint8_t>& mask) { return random_valid_action(mask, state.rng); };
+  if (plan.pilot) {
     hooks.pilot = &pilot;
-    hooks.pilot_drives = scripted;
+    hooks.pilot_drives = plan.scripted;
     hooks.pilot_noise = t.warmup_noise;
     hooks.pilot_rng = &state.rng;
   }
-  task::EpisodeSpec spec;
-  spec.seed = static_cast<std::uint64_t>(t.seed) * 1000003ULL + static_cast<std::uint64_t>(state.episode);
-  spec.stair_height = t.stair_height;
-  const task::ScenarioSpec& scenario = task::scenario_spec(t.scenario);
-  spec.obstacles = scenario.obstacles;
-  spec.variant = scenario.variant;
-  EpisodeLog log = runner.play(state.agent, spec, true, &hooks);
+  EpisodeLog log = runner.play(state.agent, plan.spec, true, &hooks);
   if (!record) full_sync();
   log.episode = state.episode;
-  log.warmup = warmup;
+  log.warmup = plan.warmup;
   return log;
 }
 
@@ -253,7 +273,19 @@ TrainerTiming Trainer::timing() const {
       {kDqn, &TrainerTiming::dqn_s},                {kClassifier, &TrainerTiming::classifier_s},
       {kEvaluation, &TrainerTiming::evaluation_s},  {kCheckpoint, &TrainerTiming::checkpoint_s},
       {kLogging, &TrainerTiming::logging_s},        {kOther, &TrainerTiming::other_s}};
-  for (const auto& [phase, field] : fields) t.*field = s(m.laps.spent[phase]);
+  std::array<Clock::duration, kPhases> spent = m.laps.spent;
+  if (m.config.trainer.simulation_threads > 1) {
+    // The simulation threads' mean. The trainer's thread closes the rounds,
+    // evaluates, checkpoints and logs while they wait: that moves from their
+    // waiting to its phases.
+    const auto n = static_cast<Clock::rep>(m.config.trainer.simulation_threads);
+    for (int p = 0; p < kPhases; ++p) spent[p] = m.threads_spent[p] / n;
+    for (Phase p : {kHandover, kDqn, kEvaluation, kCheckpoint, kLogging}) {
+      spent[kWaiting] -= m.laps.spent[p];
+      spent[p] += m.laps.spent[p];
+    }
+  }
+  for (const auto& [phase, field] : fields) t.*field = s(spent[phase]);
   t.learner_busy_s = s(m.learner_busy);
   t.checkpoints = m.run_checkpoints;
   return t;
@@ -274,39 +306,47 @@ bool Trainer::run(const std::atomic<bool>* stop) {
       m.run_time += Clock::now() - start;
     }
   } run_clock(m);
-  auto checkpoint = [&] {
-    m.save_checkpoint();
-    m.laps.lap(kCheckpoint);
-    ++m.run_checkpoints;
-  };
   if (!m.run_files) {
     m.store.create(m.config);
     m.run_files = true;
   }
+  if (t.simulation_threads > 1) return m.run_simulation_threads(stop);
   while (m.state.episode < total) {
     if (stop && stop->load()) {
-      checkpoint();
+      m.checkpoint_in_run();
       return false;
     }
     const EpisodeLog log = m.train_episode();
     ++m.state.episode;
     m.laps.lap(kOther);
-    m.store.append_episode(log);
-    if (m.callbacks.on_episode) m.callbacks.on_episode(log);
-    m.progress(log);
-    m.laps.lap(kLogging);
+    m.log_episode(log);
     const bool last = m.state.episode == total;
-    if (t.eval_interval > 0 && (m.state.episode % t.eval_interval == 0 || last)) {
-      const EvaluationLog e = m.periodic_evaluation();
-      ++m.state.evaluations;
-      m.laps.lap(kEvaluation);
-      std::fprintf(stderr, "%s\n", m.store.append_evaluation(m.config, e).c_str());
-      if (m.callbacks.on_evaluation) m.callbacks.on_evaluation(e);
-      m.laps.lap(kLogging);
-    }
-    if (m.state.episode % t.checkpoint_interval == 0 || last) checkpoint();
+    if (t.eval_interval > 0 && (m.state.episode % t.eval_interval == 0 || last)) m.evaluate_in_run();
+    if (m.state.episode % t.checkpoint_interval == 0 || last) m.checkpoint_in_run();
   }
   return true;
+}
+
+void Trainer::Impl::log_episode(const EpisodeLog& log) {
+  store.append_episode(log);
+  if (callbacks.on_episode) callbacks.on_episode(log);
+  progress(log);
+  laps.lap(kLogging);
+}
+
+void Trainer::Impl::evaluate_in_run() {
+  const EvaluationLog e = periodic_evaluation();
+  ++state.evaluations;
+  laps.lap(kEvaluation);
+  std::fprintf(stderr, "%s\n", store.append_evaluation(config, e).c_str());
+  if (callbacks.on_evaluation) callbacks.on_evaluation(e);
+  laps.lap(kLogging);
+}
+
+void Trainer::Impl::checkpoint_in_run() {
+  save_checkpoint();
+  laps.lap(kCheckpoint);
+  ++run_checkpoints;
 }
 
 }  // namespace comorph::coopt

@@ -19,13 +19,8 @@ SideRates measure_side_rates(const CooptConfig& config, std::int64_t steps) {
   const TrainerParams& t = config.trainer;
   const int total = t.total_episodes();
   // The last episode may run past `steps` by up to a whole episode.
-  std::vector<Transition> record(static_cast<std::size_t>(steps + config.env.task.max_steps + 1));
-  for (Transition& tr : record) {
-    rl::allocate(motion_spec(config), tr.obs);
-    rl::allocate(motion_spec(config), tr.next);
-    tr.action.continuous.assign(control::kActionSize, 0.0f);
-    tr.action.target.assign(control::kActionSize, 0.0f);  // so that copying a target does not allocate
-  }
+  std::vector<Transition> record;
+  allocate_transitions(config, record, static_cast<std::size_t>(steps + config.env.task.max_steps + 1));
   m.record = &record;
   SideRates rates;
   Clock::time_point start = Clock::now();

@@ -30,16 +30,24 @@ std::unique_ptr<rl::Policy> make_motion_policy(const CooptConfig& c, std::uint64
 }
 
 namespace {
-std::unique_ptr<rl::Learner> make_dqn(const CooptConfig& c, std::uint64_t seed, const rl::DqnConfig& params) {
-  if (c.trainer.mode != TrainerMode::hierarchical) return nullptr;
+rl::LearnerArgs dqn_args(const CooptConfig& c, std::uint64_t seed, const rl::DqnConfig& params) {
   rl::LearnerArgs a;
   a.observation = config_spec(c);
   a.action = {rl::ActionKind::kDiscrete, kCandidates};
   a.seed = seed;
   a.config = params;
-  return rl::make_learner("dqn", a);
+  return a;
+}
+std::unique_ptr<rl::Learner> make_dqn(const CooptConfig& c, std::uint64_t seed, const rl::DqnConfig& params) {
+  if (c.trainer.mode != TrainerMode::hierarchical) return nullptr;
+  return rl::make_learner("dqn", dqn_args(c, seed, params));
 }
 }  // namespace
+
+std::unique_ptr<rl::Policy> make_config_policy(const CooptConfig& c, bool refit) {
+  if (c.trainer.mode != TrainerMode::hierarchical) return nullptr;
+  return rl::make_policy("dqn", dqn_args(c, 0, refit ? c.dqn_refit : c.dqn));
+}
 
 std::unique_ptr<rl::Learner> make_config_model(const CooptConfig& c, std::uint64_t seed) {
   return make_dqn(c, seed, c.dqn);

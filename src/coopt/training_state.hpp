@@ -42,5 +42,8 @@ std::unique_ptr<rl::Learner> make_motion_learner(const CooptConfig& c, std::uint
 std::unique_ptr<rl::Policy> make_motion_policy(const CooptConfig& c, std::uint64_t seed);
 std::unique_ptr<rl::Learner> make_config_model(const CooptConfig& c, std::uint64_t seed);
 std::unique_ptr<rl::Learner> make_refit_config_model(const CooptConfig& c);
+// An acting copy of the configuration model (or of the refit one), for a
+// simulation thread: its weights, counters and RNG are set by the trainer.
+std::unique_ptr<rl::Policy> make_config_policy(const CooptConfig& c, bool refit);
 
 }  // namespace comorph::coopt

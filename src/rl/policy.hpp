@@ -42,6 +42,10 @@ class Policy {
   void save(const std::string& path) const;
   void load(const std::string& path);
   const LearnerCounters& counters() const { return counters_; }
+  // A trainer with several acting copies sets their schedule's clock to the
+  // whole run's counts, and each episode's random stream (coopt's simulation threads).
+  void set_counters(const LearnerCounters& counters) { counters_ = counters; }
+  void reseed(std::uint64_t seed) { rng_.seed(seed); }
 
  protected:
   // `algorithm` and `networks_key` name the checkpoint's learner and the

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <stdexcept>
 
 #include "sim/mjcf.hpp"
@@ -19,7 +20,14 @@ ModelPtr compile_mjcf(const std::string& xml) {
   const int index = mj_findFileVFS(vfs.get(), name);
   std::memcpy(vfs->filedata[index], xml.data(), xml.size());
   char error[1000] = "";
-  mjModel* m = mj_loadXML(name, vfs.get(), error, sizeof(error));
+  // MuJoCo's XML loader keeps the last parsed model in a global (mj_freeLastXML):
+  // one compilation at a time when several simulation threads reset their envs.
+  static std::mutex loader;
+  mjModel* m = nullptr;
+  {
+    std::lock_guard<std::mutex> lock(loader);
+    m = mj_loadXML(name, vfs.get(), error, sizeof(error));
+  }
   mj_deleteVFS(vfs.get());
   if (!m) throw std::runtime_error(std::string("MuJoCo could not compile the MJCF: ") + error);
   return ModelPtr(m);

@@ -325,6 +325,83 @@ TEST(Trainer, ResumeAfterInterruptionContinuesTheSameEpisodesWithIdenticalResult
   fs::remove_all(dir);
 }
 
+// trainer.simulation_threads: the threads step in rounds whose hand-over
+// follows step counts, and every episode seeds its own random streams, so a
+// (seed, thread count) pair gives the same episodes, decisions and
+// evaluations every time, with or without the learner thread; the rows come
+// in index order. A stop is taken at a block's end (here checkpoint_interval
+// 3), and a resume, after it or after a kill, continues to the numbers of
+// the uninterrupted run.
+TEST(Trainer, SimulationThreadsRepeatTheirResultsAndResumeToThem) {
+  const std::vector<std::string> sets{"trainer.episodes=6", "trainer.checkpoint_interval=3",
+                                      "trainer.simulation_threads=2"};
+  auto with = [&sets](const std::string& more) {
+    std::vector<std::string> s = sets;
+    s.push_back(more);
+    return s;
+  };
+  const std::string full_dir = temp_dir("sim_threads_full"), again_dir = temp_dir("sim_threads_again");
+  const RunResult full = run_ci(with("trainer.learner_thread=true"), full_dir);
+  const RunResult again = run_ci(with("trainer.learner_thread=false"), again_dir);
+  ASSERT_EQ(full.logs.size(), 8u);
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(full.logs[static_cast<std::size_t>(i)].episode, i);
+  EXPECT_EQ(full.episodes, again.episodes);
+  ASSERT_EQ(full.decisions.size(), again.decisions.size());
+  ASSERT_GE(full.decisions.size(), 8u);  // one or more an episode
+  for (std::size_t i = 0; i < full.decisions.size(); ++i) {
+    EXPECT_EQ(full.decisions[i].episode, again.decisions[i].episode);
+    EXPECT_EQ(full.decisions[i].modules, again.decisions[i].modules);
+    EXPECT_EQ(full.decisions[i].r2, again.decisions[i].r2);
+  }
+  EXPECT_EQ(full.evaluations, 3);  // after 3, 6 and 8 episodes
+  EXPECT_EQ(read_checkpoint_info(full_dir).env_steps, read_checkpoint_info(again_dir).env_steps);
+  // Both threads played: episodes 0 and 1 started together, so the second
+  // one's scene is the one its index gives, not a continuation of the first.
+  EXPECT_NE(full.logs[0].seed, full.logs[1].seed);
+
+  // Ctrl-C after episode index 3 is written: the block [3, 6) is finished first.
+  const CooptConfig c = load_coopt_config(kCi, with("trainer.learner_thread=true"));
+  const std::string dir = temp_dir("sim_threads_resume");
+  RunResult part;
+  {
+    std::atomic<bool> stop{false};
+    TrainerCallbacks cb = collecting(part);
+    auto inner = cb.on_episode;
+    cb.on_episode = [&stop, inner](const EpisodeLog& l) {
+      inner(l);
+      if (l.episode == 3) stop = true;
+    };
+    Trainer t(c, dir, cb);
+    EXPECT_FALSE(t.run(&stop));
+    EXPECT_EQ(t.episodes_done(), 6);
+  }
+  EXPECT_EQ(read_checkpoint_info(dir).episodes, 6);
+  // kill -9 after episode index 6 is written, before the checkpoint of the block [6, 8).
+  {
+    TrainerCallbacks cb = collecting(part);
+    auto inner = cb.on_episode;
+    cb.on_episode = [inner](const EpisodeLog& l) {
+      inner(l);
+      if (l.episode == 6) throw std::runtime_error("killed");
+    };
+    Trainer t(c, dir, cb);
+    t.resume();
+    EXPECT_THROW(t.run(), std::runtime_error);
+  }
+  RunResult rest;
+  {
+    Trainer t(c, dir, collecting(rest));
+    t.resume();
+    EXPECT_EQ(t.episodes_done(), 6);
+    EXPECT_TRUE(t.run());
+  }
+  ASSERT_EQ(rest.episodes.size(), 2u);
+  EXPECT_EQ(rest.episodes[0], full.episodes[6]);
+  EXPECT_EQ(rest.episodes[1], full.episodes[7]);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(part.episodes[static_cast<std::size_t>(i)], full.episodes[static_cast<std::size_t>(i)]);
+  for (const std::string& d : {full_dir, again_dir, dir}) fs::remove_all(d);
+}
+
 // Checkpoints write the replay as segments (rl/replay_segments.hpp): only
 // the transitions since the previous checkpoint, the still-needed older
 // segments hard-linked. With a 400-transition buffer the ring wraps about
