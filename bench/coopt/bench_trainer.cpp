@@ -6,7 +6,9 @@
 //   - each side alone on the same preset (coopt::measure_side_rates): the
 //     acting side (env, acting copy, pilot, scene source, DQN) and the motion
 //     learner (store + updates); bound fraction = trainer / the slower side
-//     (without a learner thread: / the rate of both sides one after the other);
+//     (N simulation threads: N times the acting side, and no more work than
+//     the cores can do; without a learner thread: / the rate of both sides
+//     one after the other);
 //   - each thread's share of the trainer's wall time (coopt::TrainerTiming);
 //   - the checkpoint: s for one with a full motion replay, s for the next one
 //     after checkpoint_interval episodes of new transitions, and that next
@@ -22,6 +24,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "common/heap.hpp"
@@ -108,11 +111,17 @@ int main(int argc, char** argv) {
 
     // 2. Each side alone.
     const coopt::SideRates sides = coopt::measure_side_rates(config, steps);
-    // Two threads run at the slower side's rate at best; one thread (no
-    // learner thread) does both sides' work one after the other.
+    // With a learner thread: the slower of the acting side (N simulation
+    // threads act N times as fast at best) and the learner, and the cores cap
+    // the sum of both sides' work (cores / CPU time of a step's acting and
+    // learning). Without one the learner runs while the simulation waits.
+    const int sims = config.trainer.simulation_threads;
+    const double cores = std::max(1u, std::thread::hardware_concurrency());
+    const double acting = std::min<double>(sims, cores) * sides.acting_steps_per_s;
+    const double both_s = 1.0 / sides.acting_steps_per_s + 1.0 / sides.learner_steps_per_s;
     const double bound = config.trainer.learner_thread
-                             ? std::min(sides.acting_steps_per_s, sides.learner_steps_per_s)
-                             : 1.0 / (1.0 / sides.acting_steps_per_s + 1.0 / sides.learner_steps_per_s);
+                             ? std::min({acting, sides.learner_steps_per_s, cores / both_s})
+                             : 1.0 / (1.0 / acting + 1.0 / sides.learner_steps_per_s);
 
     // 3. Checkpoints: one with the motion replay full, then one after
     //    checkpoint_interval episodes of the trainer's mean length.
@@ -137,6 +146,7 @@ int main(int argc, char** argv) {
     out["steps"] = trainer_steps;
     out["episodes"] = episodes;
     out["learner_thread"] = config.trainer.learner_thread;
+  out["simulation_threads"] = config.trainer.simulation_threads;
     out["steps_per_s"] = steps_per_s;
     out["env_only_steps_per_s"] = sides.acting_steps_per_s;
     out["learner_only_steps_per_s"] = sides.learner_steps_per_s;
@@ -156,8 +166,9 @@ int main(int argc, char** argv) {
       fmt::print("{}\n", out.dump());
       return 0;
     }
-    fmt::print("{}: {} control steps in {} episodes, learner thread {}\n", config_path, trainer_steps, episodes,
-               config.trainer.learner_thread ? "on" : "off");
+    fmt::print("{}: {} control steps in {} episodes, learner thread {}, {} simulation thread(s)\n", config_path,
+               trainer_steps, episodes, config.trainer.learner_thread ? "on" : "off",
+               config.trainer.simulation_threads);
     fmt::print("trainer             {:8.0f} control steps/s ({:.1f} s wall)\n", steps_per_s, timing.wall_s);
     fmt::print("acting side alone   {:8.0f} control steps/s ({} steps: env, acting copy, pilot, scene, DQN)\n",
                sides.acting_steps_per_s, sides.acting_steps);
