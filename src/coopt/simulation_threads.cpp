@@ -5,6 +5,7 @@
 #include <torch/torch.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <map>
 
 #include "coopt/segment.hpp"
@@ -304,7 +305,13 @@ bool Trainer::Impl::run_simulation_threads(const std::atomic<bool>* stop) {
       }
     }
     laps.lap(kOther);
+    bool stop_said = false;
     while (active > 0) {
+      if (stop && stop->load() && !stop_said) {
+        std::fprintf(stderr, "stopping: the threads finish episodes %d to %d (a block), then the checkpoint\n",
+                     state.episode + 1, end);
+        stop_said = true;
+      }
       release_threads();
       wait_for_threads(active);
       end_round();

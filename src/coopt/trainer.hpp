@@ -149,7 +149,9 @@ class Trainer {
   // evaluations.csv to the rows the checkpoint counted.
   void resume();
   // Trains until every episode is done (returns true) or *stop becomes true
-  // (the current episode is finished and checkpointed; returns false). A run
+  // (the current episode is finished and checkpointed; returns false; with
+  // trainer.simulation_threads > 1 the current block of episodes, which ends
+  // at the next multiple of checkpoint_interval or eval_interval). A run
   // not resumed starts by writing config.yaml, run.yaml and the CSV headers
   // (throws when run_dir already holds a run: resume() it instead).
   bool run(const std::atomic<bool>* stop = nullptr);

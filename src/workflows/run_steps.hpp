@@ -12,7 +12,8 @@ namespace comorph::workflows {
 
 // Trains a new run into `out` (config file + `--set`s) or, when `resume` is
 // given, continues that run from its last checkpoint. SIGINT/SIGTERM finish
-// the current episode and write a checkpoint; returns false then, true when
+// the current episode (with trainer.simulation_threads > 1: the current block,
+// at most checkpoint_interval episodes) and write a checkpoint; returns false then, true when
 // every episode is done. The run directory is locked (common/run_lock.hpp)
 // for the whole training unless `locked_by_caller` (`comorph experiment`
 // holds the column's lock itself). A resume is refused when episodes.csv or
