@@ -101,6 +101,13 @@ void Trainer::Impl::stop_threads() {
     for (int p = 0; p < kPhases; ++p) threads_spent[p] += s->laps.spent[p];
     s->laps.spent = {};
   }
+  // The learner thread's job reads the threads' buffers and the round's
+  // lists. After a normal end it is done already; on an error's way out its
+  // own error would only hide the first one.
+  try {
+    worker->wait();
+  } catch (...) {
+  }
   rounds.reset();
 }
 
@@ -210,6 +217,7 @@ void Trainer::Impl::sync_threads(bool all) {
       s.agent.config_copy->sync_from(*dqn);
       s.config_synced_updates = dqn->counters().updates;
     }
+    s.agent.config_copy->set_counters(dqn->counters());  // its epsilon's clock
   }
 }
 
@@ -220,7 +228,6 @@ void Trainer::Impl::release_threads() {
       if (s->episode < 0) continue;
       // The acting schedules' clocks: the run's counts (as one thread's would be).
       s->agent.motion->set_counters({state.steps, s->episode, 0});
-      if (s->agent.config_copy) s->agent.config_copy->set_counters(state.agent.config->counters());
     }
     ++rounds->generation;
   }
@@ -238,34 +245,36 @@ void Trainer::Impl::wait_for_threads(int active) {
 }
 
 void Trainer::Impl::end_round() {
-  // 1. The configuration model learns the round's decisions, thread by thread.
-  for (auto& s : threads) {
-    for (const StoredDecision& d : s->decisions) store_and_update(*state.agent.config, d.transition, d.k);
-    s->decisions.clear();
-    for (const DecisionLog& d : s->decision_logs) callbacks.on_decision(d);
-    s->decision_logs.clear();
-  }
-  laps.lap(kDqn);
-  // 2. The motion learner: after its previous job, its weights into the
-  //    acting copies, then the round's transitions in thread order.
+  // The learners' previous job done: their weights into the acting copies,
+  // then the round's transitions (motion) and decisions (DQN), in thread
+  // order, as the next job; it runs while the threads simulate the next round.
   worker->wait();
   laps.lap(kWaiting);
   sync_threads(false);
   std::vector<Rounds::Batch>& batches = rounds->batches;
+  std::vector<StoredDecision>& decisions = rounds->decisions;
   batches.clear();
+  decisions.clear();
   for (auto& s : threads) {
     if (s->stored > 0) batches.push_back({&s->pending[s->filling], s->stored});
     s->filling = 1 - s->filling;
     state.steps += s->round_steps;
     s->round_steps = s->stored = 0;
+    for (StoredDecision& d : s->decisions) decisions.push_back(std::move(d));
+    s->decisions.clear();
+    if (callbacks.on_decision)
+      for (const DecisionLog& d : s->decision_logs) callbacks.on_decision(d);
+    s->decision_logs.clear();
   }
-  if (!batches.empty()) {
-    rl::Learner* l = state.motion.get();
+  if (!batches.empty() || !decisions.empty()) {
+    rl::Learner* motion = state.motion.get();
+    rl::Learner* dqn = state.agent.config.get();
     Clock::duration* busy = &learner_busy;
-    worker->submit([l, &batches, busy] {
+    worker->submit([motion, dqn, &batches, &decisions, busy] {
       const Clock::time_point start = Clock::now();
       for (const Rounds::Batch& b : batches)
-        for (int i = 0; i < b.count; ++i) store_and_update(*l, (*b.transitions)[static_cast<std::size_t>(i)]);
+        for (int i = 0; i < b.count; ++i) store_and_update(*motion, (*b.transitions)[static_cast<std::size_t>(i)]);
+      for (const StoredDecision& d : decisions) store_and_update(*dqn, d.transition, d.k);
       *busy += Clock::now() - start;
     });
   }

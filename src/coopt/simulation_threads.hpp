@@ -5,13 +5,14 @@
 // simulation_threads.cpp use it.
 //
 // A round: every thread with an episode steps until it has sync_interval
-// control steps or its episode ends, then waits. The trainer's thread then,
-// in thread order, stores the round's decisions into the configuration model,
-// takes the motion learner's previous job, copies its weights into every
-// acting copy and hands it the round's transitions; it writes the episodes
-// that ended (in index order) and gives their threads the next indices. Those
-// are function of step counts only, and each episode seeds its own random
-// streams, so a (seed, thread count) pair gives the same results every time.
+// control steps or its episode ends, then waits. The trainer's thread then
+// waits for the learner thread's previous job, copies both models' weights
+// into every acting copy and hands over the round's transitions (motion
+// model) and decisions (configuration model), thread by thread, as the next
+// job; it writes the episodes that ended (in index order) and gives their
+// threads the next indices. All of it follows step counts only, and each
+// episode seeds its own random streams, so a (seed, thread count) pair gives
+// the same results every time.
 // Checkpoints, evaluations and the DQN refit's start fall at block ends, when
 // every thread has ended its episode and the learner has caught up.
 #pragma once
@@ -76,13 +77,14 @@ struct Rounds {
   int arrived = 0;
   bool quit = false;
   std::exception_ptr error;  // the first exception of a simulation thread
-  // The learner's job: the round's transitions, thread by thread (rebuilt
-  // after the previous job has ended).
+  // The learner thread's job: the round's transitions and decisions, thread
+  // by thread (rebuilt after the previous job has ended).
   struct Batch {
     const std::vector<Transition>* transitions;
     int count;
   };
   std::vector<Batch> batches;
+  std::vector<StoredDecision> decisions;
 };
 
 }  // namespace comorph::coopt
