@@ -14,6 +14,7 @@
 //     after checkpoint_interval episodes of new transitions, and that next
 //     one's share of the wall time of checkpoint_interval episodes.
 // Usage: bench_trainer [--config configs/standard.yaml] [--steps 50000] [--set k=v ...] [--json]
+//        [--no-checkpoint-cost] [--trainer-only]
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -72,13 +73,16 @@ int main(int argc, char** argv) {
   std::string config_path = resource_path("configs/quick.yaml");
   std::vector<std::string> sets;
   std::int64_t steps = 20000;
-  bool json = false, skip_checkpoint = false;
+  bool json = false, skip_checkpoint = false, trainer_only = false;
   app.add_option("--config", config_path, "preset (default configs/quick.yaml)")->check(CLI::ExistingFile);
   app.add_option("--set", sets, "config override key=value, as in `comorph train`");
   app.add_option("--steps", steps, "control steps of the trainer and of each side alone (default 20000)")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1000000000}));
   app.add_flag("--json", json, "print one JSON object instead of text");
   app.add_flag("--no-checkpoint-cost", skip_checkpoint, "skip the full-replay checkpoint measurement");
+  app.add_flag("--trainer-only", trainer_only,
+               "the trainer and its shares only: no side rates, no bound fraction (for the DQN refit, where "
+               "the motion learner has nothing to learn)");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -110,7 +114,7 @@ int main(int argc, char** argv) {
     const double steps_per_s = static_cast<double>(trainer_steps) / timing.wall_s;
 
     // 2. Each side alone.
-    const coopt::SideRates sides = coopt::measure_side_rates(config, steps);
+    const coopt::SideRates sides = trainer_only ? coopt::SideRates{} : coopt::measure_side_rates(config, steps);
     // With a learner thread: the slower of the acting side (N simulation
     // threads act N times as fast at best) and the learner, and the cores cap
     // the sum of both sides' work (cores / CPU time of a step's acting and
@@ -132,7 +136,7 @@ int main(int argc, char** argv) {
         config.trainer.motion_algo == "sac" ? config.sac.buffer_size : config.td3.buffer_size;
     const auto new_transitions = static_cast<std::int64_t>(interval * steps_per_episode);
     coopt::CheckpointCost cost;
-    if (!skip_checkpoint) {
+    if (!skip_checkpoint && !trainer_only) {
       const std::string dir = (scratch / "checkpoint-cost").string();
       fs::create_directories(dir);
       cost = coopt::measure_checkpoint_cost(config, dir, replay, new_transitions);
@@ -146,14 +150,16 @@ int main(int argc, char** argv) {
     out["steps"] = trainer_steps;
     out["episodes"] = episodes;
     out["learner_thread"] = config.trainer.learner_thread;
-  out["simulation_threads"] = config.trainer.simulation_threads;
+    out["simulation_threads"] = config.trainer.simulation_threads;
     out["steps_per_s"] = steps_per_s;
-    out["env_only_steps_per_s"] = sides.acting_steps_per_s;
-    out["learner_only_steps_per_s"] = sides.learner_steps_per_s;
-    out["bound_fraction"] = steps_per_s / bound;
+    if (!trainer_only) {
+      out["env_only_steps_per_s"] = sides.acting_steps_per_s;
+      out["learner_only_steps_per_s"] = sides.learner_steps_per_s;
+      out["bound_fraction"] = steps_per_s / bound;
+    }
     out["share"] = shares(timing, config.trainer.learner_thread);
     out["checkpoints_in_run"] = timing.checkpoints;
-    if (!skip_checkpoint) {
+    if (!skip_checkpoint && !trainer_only) {
       out["checkpoint"] = {{"replay_transitions", replay},
                            {"full_replay_s", cost.first_s},
                            {"new_transitions", new_transitions},
@@ -170,15 +176,17 @@ int main(int argc, char** argv) {
                trainer_steps, episodes, config.trainer.learner_thread ? "on" : "off",
                config.trainer.simulation_threads);
     fmt::print("trainer             {:8.0f} control steps/s ({:.1f} s wall)\n", steps_per_s, timing.wall_s);
-    fmt::print("acting side alone   {:8.0f} control steps/s ({} steps: env, acting copy, pilot, scene, DQN)\n",
-               sides.acting_steps_per_s, sides.acting_steps);
-    fmt::print("learner alone       {:8.0f} control steps/s ({} steps after learning_starts: store + updates)\n",
-               sides.learner_steps_per_s, sides.learner_steps);
-    fmt::print("bound fraction      {:8.2f} (trainer / {})\n", steps_per_s / bound,
-               config.trainer.learner_thread ? "the slower side" : "both sides one after the other");
+    if (!trainer_only) {
+      fmt::print("acting side alone   {:8.0f} control steps/s ({} steps: env, acting copy, pilot, scene, DQN)\n",
+                 sides.acting_steps_per_s, sides.acting_steps);
+      fmt::print("learner alone       {:8.0f} control steps/s ({} steps after learning_starts: store + updates)\n",
+                 sides.learner_steps_per_s, sides.learner_steps);
+      fmt::print("bound fraction      {:8.2f} (trainer / {})\n", steps_per_s / bound,
+                 config.trainer.learner_thread ? "the slower side" : "both sides one after the other");
+    }
     fmt::print("share of the trainer's wall time:\n");
     for (const auto& [key, value] : out["share"].items()) fmt::print("  {:<16} {:6.3f}\n", key, value.get<double>());
-    if (!skip_checkpoint)
+    if (!skip_checkpoint && !trainer_only)
       fmt::print("checkpoint: {:.2f} s with {} transitions in the motion replay; the next after {} more "
                  "({} episodes of {:.0f} steps): {:.2f} s = {:.2f} % of those episodes' {:.0f} s\n",
                  cost.first_s, replay, new_transitions, interval, steps_per_episode, cost.next_s,

@@ -72,9 +72,10 @@ struct TrainerParams {
   int torch_threads = 1;              // torch intra-op threads per thread (1: small nets, reproducible)
   // Simulation threads, each with its own env, scene source, pilot and acting
   // copies of both models, feeding the one learner (coopt/simulation_threads.cpp).
-  // 1: the single acting thread above. N > 1: they step in rounds of
-  // sync_interval control steps (a thread whose episode ends waits for the
-  // round's end), the round's transitions go to the learner in thread order,
+  // 1: the single acting thread above. N > 1: they step in rounds of equal
+  // simulation work (sync_interval control steps of a 4-module chain; a
+  // thread whose episode ends waits for the round's end), the round's
+  // transitions and decisions go to the learner thread in thread order,
   // and every episode draws from its own random streams; so a (seed, N) pair
   // gives the same results every time, but not those of another N.
   int simulation_threads = 1;

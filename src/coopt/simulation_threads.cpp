@@ -40,6 +40,16 @@ int block_end(const TrainerParams& t, int from) {
   return end;
 }
 
+// A round gives every thread the same simulation work, not the same steps:
+// a control step costs about 60 + 128 us per module (bench_sim: 301 us for 2
+// modules, 1338 for 10), so with equal steps a thread with 3 modules would
+// wait for one with 9 most of the round. In units of 64 us: 2 per module + 1.
+// A round is worth sync_interval steps of a 4-module chain; a thread with 2
+// modules takes 1.8 times as many, one with 10 0.43 times. Module counts are
+// part of the run, so this too follows the run and not the timing.
+int step_cost(int modules) { return 2 * modules + 1; }
+int round_quota(const TrainerParams& t) { return t.sync_interval * step_cost(4); }
+
 // A simulation thread waits for the trainer's next release (after arriving:
 // its round is done); returns the episode it is to play, -1 when idle.
 int await_release(Rounds& r, SimulationThread& s, bool arrive) {
@@ -64,7 +74,9 @@ SimulationThread::SimulationThread(const CooptConfig& c, const std::function<int
     : runner(c, label_source) {
   agent.motion = make_motion_policy(c, static_cast<std::uint64_t>(c.trainer.seed) + 1);
   configure_pilot(c.trainer, pilot);
-  for (auto& p : pending) allocate_transitions(c, p, static_cast<std::size_t>(c.trainer.sync_interval));
+  // The most steps a round can hold: its quota in steps of the shortest chain.
+  const int most = (round_quota(c.trainer) + step_cost(kMinModules) - 1) / step_cost(kMinModules);
+  for (auto& p : pending) allocate_transitions(c, p, static_cast<std::size_t>(most));
 }
 
 Trainer::Impl::~Impl() { stop_threads(); }
@@ -79,7 +91,7 @@ void Trainer::Impl::start_threads() {
     // What an interrupted run may have left.
     s->episode = -1;
     s->ended = false;
-    s->round_steps = s->stored = 0;
+    s->round_steps = s->stored = s->round_cost = 0;
     s->decisions.clear();
     s->decision_logs.clear();
     s->episode_decisions.clear();
@@ -147,7 +159,9 @@ void Trainer::Impl::play_in_thread(SimulationThread& s, int episode) {
       s.agent.motion->count(term, trunc);
       s.pending[s.filling][static_cast<std::size_t>(s.stored++)].set(o, a, r, n, term, trunc);
     }
-    if (++s.round_steps == config.trainer.sync_interval && !term && !trunc) await_release(*rounds, s, true);
+    ++s.round_steps;
+    s.round_cost += step_cost(s.runner.env().modules());
+    if (s.round_cost >= round_quota(config.trainer) && !term && !trunc) await_release(*rounds, s, true);
   };
   hooks.motion_greedy = plan.greedy_motion;
   hooks.config = [this, &s, episode, learns = plan.config_learns](const rl::Observation& o, const rl::Action& a,
@@ -259,7 +273,7 @@ void Trainer::Impl::end_round() {
     if (s->stored > 0) batches.push_back({&s->pending[s->filling], s->stored});
     s->filling = 1 - s->filling;
     state.steps += s->round_steps;
-    s->round_steps = s->stored = 0;
+    s->round_steps = s->stored = s->round_cost = 0;
     for (StoredDecision& d : s->decisions) decisions.push_back(std::move(d));
     s->decisions.clear();
     if (callbacks.on_decision)

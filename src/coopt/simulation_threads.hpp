@@ -4,8 +4,9 @@
 // trainer's own thread closes. Internal to coopt: trainer.cpp and
 // simulation_threads.cpp use it.
 //
-// A round: every thread with an episode steps until it has sync_interval
-// control steps or its episode ends, then waits. The trainer's thread then
+// A round: every thread with an episode steps until it has done a round's
+// simulation work (sync_interval control steps of a 4-module chain; more
+// steps with fewer modules) or its episode ends, then waits. The trainer's thread then
 // waits for the learner thread's previous job, copies both models' weights
 // into every acting copy and hands over the round's transitions (motion
 // model) and decisions (configuration model), thread by thread, as the next
@@ -53,6 +54,7 @@ struct SimulationThread {
   int filling = 0;
   int round_steps = 0;           // control steps in the current round
   int stored = 0;                // of those, transitions for the motion learner (none in the refit)
+  int round_cost = 0;            // their simulation cost (simulation_threads.cpp: step_cost)
   // The round's decisions for the DQN (and their log rows), in order.
   std::vector<StoredDecision> decisions;
   std::vector<DecisionLog> decision_logs;
