@@ -58,8 +58,9 @@ TrainerCallbacks collecting(RunResult& r) {
 }
 
 // A run in `dir` interrupted (Ctrl-C) after episode index `last` ends:
-// that episode is finished and checkpointed. Its rows go to `part`.
-void run_until_stopped(const CooptConfig& c, const std::string& dir, int last, RunResult& part) {
+// that episode is finished and checkpointed (with simulation threads, the
+// block holding it: `done` episodes). Its rows go to `part`.
+void run_until_stopped(const CooptConfig& c, const std::string& dir, int last, RunResult& part, int done = -1) {
   std::atomic<bool> stop{false};
   TrainerCallbacks cb = collecting(part);
   auto inner = cb.on_episode;
@@ -69,7 +70,22 @@ void run_until_stopped(const CooptConfig& c, const std::string& dir, int last, R
   };
   Trainer t(c, dir, cb);
   EXPECT_FALSE(t.run(&stop));
-  EXPECT_EQ(t.episodes_done(), last + 1);
+  EXPECT_EQ(t.episodes_done(), done < 0 ? last + 1 : done);
+}
+
+// The run in `dir` resumed (after `done` episodes) and killed (kill -9)
+// right after episode index `last` is written, before its checkpoint.
+void resume_until_killed(const CooptConfig& c, const std::string& dir, int done, int last, RunResult& part) {
+  TrainerCallbacks cb = collecting(part);
+  auto inner = cb.on_episode;
+  cb.on_episode = [inner, last](const EpisodeLog& l) {
+    inner(l);
+    if (l.episode == last) throw std::runtime_error("killed");
+  };
+  Trainer t(c, dir, cb);
+  t.resume();
+  EXPECT_EQ(t.episodes_done(), done);
+  EXPECT_THROW(t.run(), std::runtime_error);
 }
 
 RunResult run_ci(const std::vector<std::string>& sets, const std::string& dir) {
@@ -295,18 +311,7 @@ TEST(Trainer, ResumeAfterInterruptionContinuesTheSameEpisodesWithIdenticalResult
   run_until_stopped(c, dir, 4, part);
   // kill -9 after episode 7 was logged but before its checkpoint (every 3):
   // the CSV has a row the checkpoint does not count.
-  {
-    TrainerCallbacks cb = collecting(part);
-    auto inner = cb.on_episode;
-    cb.on_episode = [inner](const EpisodeLog& l) {
-      inner(l);
-      if (l.episode == 6) throw std::runtime_error("killed");
-    };
-    Trainer t(c, dir, cb);
-    t.resume();
-    EXPECT_EQ(t.episodes_done(), 5);
-    EXPECT_THROW(t.run(), std::runtime_error);
-  }
+  resume_until_killed(c, dir, 5, 6, part);
   EXPECT_EQ(read_checkpoint_info(dir).episodes, 6);
   EXPECT_EQ(csv_rows(dir).size(), 7u);
   RunResult rest;
@@ -363,31 +368,10 @@ TEST(Trainer, SimulationThreadsRepeatTheirResultsAndResumeToThem) {
   const CooptConfig c = load_coopt_config(kCi, with("trainer.learner_thread=true"));
   const std::string dir = temp_dir("sim_threads_resume");
   RunResult part;
-  {
-    std::atomic<bool> stop{false};
-    TrainerCallbacks cb = collecting(part);
-    auto inner = cb.on_episode;
-    cb.on_episode = [&stop, inner](const EpisodeLog& l) {
-      inner(l);
-      if (l.episode == 3) stop = true;
-    };
-    Trainer t(c, dir, cb);
-    EXPECT_FALSE(t.run(&stop));
-    EXPECT_EQ(t.episodes_done(), 6);
-  }
+  run_until_stopped(c, dir, 3, part, 6);
   EXPECT_EQ(read_checkpoint_info(dir).episodes, 6);
   // kill -9 after episode index 6 is written, before the checkpoint of the block [6, 8).
-  {
-    TrainerCallbacks cb = collecting(part);
-    auto inner = cb.on_episode;
-    cb.on_episode = [inner](const EpisodeLog& l) {
-      inner(l);
-      if (l.episode == 6) throw std::runtime_error("killed");
-    };
-    Trainer t(c, dir, cb);
-    t.resume();
-    EXPECT_THROW(t.run(), std::runtime_error);
-  }
+  resume_until_killed(c, dir, 6, 6, part);
   RunResult rest;
   {
     Trainer t(c, dir, collecting(rest));
@@ -399,7 +383,17 @@ TEST(Trainer, SimulationThreadsRepeatTheirResultsAndResumeToThem) {
   EXPECT_EQ(rest.episodes[0], full.episodes[6]);
   EXPECT_EQ(rest.episodes[1], full.episodes[7]);
   for (int i = 0; i < 6; ++i) EXPECT_EQ(part.episodes[static_cast<std::size_t>(i)], full.episodes[static_cast<std::size_t>(i)]);
-  for (const std::string& d : {full_dir, again_dir, dir}) fs::remove_all(d);
+
+  // The DQN refit (its fresh DQN made at a block's start, the threads' copies
+  // rebuilt) repeats too.
+  const std::string refit_a = temp_dir("sim_threads_refit_a"), refit_b = temp_dir("sim_threads_refit_b");
+  const RunResult ra = run_ci({"trainer.simulation_threads=2", "trainer.config_refit_episodes=4"}, refit_a);
+  const RunResult rb =
+      run_ci({"trainer.simulation_threads=2", "trainer.config_refit_episodes=4", "trainer.learner_thread=false"},
+             refit_b);
+  ASSERT_EQ(ra.episodes.size(), 10u);
+  EXPECT_EQ(ra.episodes, rb.episodes);
+  for (const std::string& d : {full_dir, again_dir, dir, refit_a, refit_b}) fs::remove_all(d);
 }
 
 // Checkpoints write the replay as segments (rl/replay_segments.hpp): only
