@@ -3,7 +3,8 @@
 //   - the trainer's control steps/s over --steps control steps (whole
 //     episodes, the run's own seeds, writing episodes.csv as `comorph train`
 //     does, ending with a checkpoint as an interrupted run does);
-//   - each side alone on the same preset (coopt::measure_side_rates): the
+//   - each side alone on the same preset (coopt::measure_side_rates, once
+//     before the trainer and once after, their mean rate): the
 //     acting side (env, acting copy, pilot, scene source, DQN) and the motion
 //     learner (store + updates); bound fraction = trainer / the slower side
 //     (N simulation threads: N times the acting side, and no more work than
@@ -93,7 +94,12 @@ int main(int argc, char** argv) {
     const std::string run_dir = (scratch / "run").string();
     fs::create_directories(run_dir);
 
-    // 1. The trainer, stopped after the episode that reaches --steps.
+    // 1. Each side alone before the trainer, and again after it (2.): this
+    //    machine's speed drifts by up to 1.5x between minutes, and a drift
+    //    that is linear in time cancels in the mean over the two.
+    const coopt::SideRates before = trainer_only ? coopt::SideRates{} : coopt::measure_side_rates(config, steps);
+
+    // 2. The trainer, stopped after the episode that reaches --steps.
     std::atomic<bool> stop{false};
     std::int64_t done = 0;
     int episodes = 0;
@@ -113,8 +119,13 @@ int main(int argc, char** argv) {
     }
     const double steps_per_s = static_cast<double>(trainer_steps) / timing.wall_s;
 
-    // 2. Each side alone.
-    const coopt::SideRates sides = trainer_only ? coopt::SideRates{} : coopt::measure_side_rates(config, steps);
+    // 3. Each side alone again.
+    const coopt::SideRates after = trainer_only ? coopt::SideRates{} : coopt::measure_side_rates(config, steps);
+    // Each side's rate over both of its runs (the same steps: steps over the summed time).
+    auto both = [](double a, double b) { return a > 0 && b > 0 ? 2.0 / (1.0 / a + 1.0 / b) : 0.0; };
+    coopt::SideRates sides = after;
+    sides.acting_steps_per_s = both(before.acting_steps_per_s, after.acting_steps_per_s);
+    sides.learner_steps_per_s = both(before.learner_steps_per_s, after.learner_steps_per_s);
     // With a learner thread: the slower of the acting side (N simulation
     // threads act N times as fast at best) and the learner, and the cores cap
     // the sum of both sides' work (cores / CPU time of a step's acting and
@@ -127,7 +138,7 @@ int main(int argc, char** argv) {
                              ? std::min({acting, sides.learner_steps_per_s, cores / both_s})
                              : 1.0 / (1.0 / acting + 1.0 / sides.learner_steps_per_s);
 
-    // 3. Checkpoints: one with the motion replay full, then one after
+    // 4. Checkpoints: one with the motion replay full, then one after
     //    checkpoint_interval episodes of the trainer's mean length.
     const int interval = config.trainer.checkpoint_interval;
     const double steps_per_episode = static_cast<double>(trainer_steps) / episodes;
@@ -156,6 +167,8 @@ int main(int argc, char** argv) {
       out["env_only_steps_per_s"] = sides.acting_steps_per_s;
       out["learner_only_steps_per_s"] = sides.learner_steps_per_s;
       out["bound_fraction"] = steps_per_s / bound;
+      out["sides_before_after"] = {{"env_only_steps_per_s", {before.acting_steps_per_s, after.acting_steps_per_s}},
+                                   {"learner_only_steps_per_s", {before.learner_steps_per_s, after.learner_steps_per_s}}};
     }
     out["share"] = shares(timing, config.trainer.learner_thread);
     out["checkpoints_in_run"] = timing.checkpoints;
@@ -177,10 +190,13 @@ int main(int argc, char** argv) {
                config.trainer.simulation_threads);
     fmt::print("trainer             {:8.0f} control steps/s ({:.1f} s wall)\n", steps_per_s, timing.wall_s);
     if (!trainer_only) {
-      fmt::print("acting side alone   {:8.0f} control steps/s ({} steps: env, acting copy, pilot, scene, DQN)\n",
-                 sides.acting_steps_per_s, sides.acting_steps);
-      fmt::print("learner alone       {:8.0f} control steps/s ({} steps after learning_starts: store + updates)\n",
-                 sides.learner_steps_per_s, sides.learner_steps);
+      fmt::print("acting side alone   {:8.0f} control steps/s ({} steps: env, acting copy, pilot, scene, DQN; "
+                 "{:.0f} before the trainer, {:.0f} after)\n",
+                 sides.acting_steps_per_s, sides.acting_steps, before.acting_steps_per_s, after.acting_steps_per_s);
+      fmt::print("learner alone       {:8.0f} control steps/s ({} steps after learning_starts: store + updates; "
+                 "{:.0f} before, {:.0f} after)\n",
+                 sides.learner_steps_per_s, sides.learner_steps, before.learner_steps_per_s,
+                 after.learner_steps_per_s);
       fmt::print("bound fraction      {:8.2f} (trainer / {})\n", steps_per_s / bound,
                  config.trainer.learner_thread ? "the slower side" : "both sides one after the other");
     }
