@@ -11,7 +11,7 @@
 // into every acting copy and hands over the round's transitions (motion
 // model) and decisions (configuration model), thread by thread, as the next
 // job; it writes the episodes that ended (in index order) and gives their
-// threads the next indices. All of it follows step counts only, and each
+// threads the next indices. All of it follows the run (steps, module counts), and each
 // episode seeds its own random streams, so a (seed, thread count) pair gives
 // the same results every time.
 // Checkpoints, evaluations and the DQN refit's start fall at block ends, when
