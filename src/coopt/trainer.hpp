@@ -120,6 +120,10 @@ void truncate_csv_rows(const std::string& path, int rows);
 // they add up to wall_s; motion_updates_s is on that thread only without a
 // learner thread (trainer.learner_thread: false). learner_busy_s is the time
 // the learner spent in its jobs (store + updates), on whichever thread ran them.
+// With trainer.simulation_threads > 1 the fields are the mean over those
+// threads (their wait at a round's end in waiting_s), the trainer's own
+// thread's round closing, evaluations, checkpoints and logging taken out of
+// that wait into their fields, and learner_busy_s holds the DQN's jobs too.
 struct TrainerTiming {
   double wall_s = 0;            // run() calls of this object, summed
   double env_step_s = 0;        // MultiTaskEnv::step
