@@ -175,17 +175,9 @@ void Trainer::Impl::play_in_thread(SimulationThread& s, int episode) {
       d.action = a;
       s.episode_decision_returns.push_back(r2);
       if (term || trunc) {
-        // As learn_episode_returns(): terminal transitions of the returns.
-        to_decision_returns(s.episode_decision_returns, config.dqn.gamma);
-        for (std::size_t i = 0; i < s.episode_decisions.size(); ++i) {
-          StoredDecision& sd = s.decisions.emplace_back();
-          sd.transition = std::move(s.episode_decisions[i]);
-          sd.transition.reward = s.episode_decision_returns[i];
-          sd.transition.terminated = true;
-          sd.transition.truncated = false;
-        }
+        to_return_transitions(s.episode_decisions, s.episode_decision_returns, config.dqn.gamma);
+        for (Transition& d : s.episode_decisions) s.decisions.push_back({std::move(d), 1});
         s.episode_decisions.clear();
-        s.episode_decision_returns.clear();
       }
     } else {
       StoredDecision& sd = s.decisions.emplace_back();

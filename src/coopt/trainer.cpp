@@ -133,17 +133,20 @@ void Trainer::Impl::full_sync() {
 // stored with the R2 of its own and every later segment (each later one
 // discounted once more by dqn.gamma) as a terminal transition.
 void Trainer::Impl::learn_episode_returns() {
-  to_decision_returns(episode_decision_returns, config.dqn.gamma);
-  for (std::size_t i = 0; i < episode_decisions.size(); ++i) {
-    Transition& d = episode_decisions[i];
-    // Terminal: no bootstrap, so the segment's length (the discount's k) plays no part.
-    d.reward = episode_decision_returns[i];
-    d.terminated = true;
-    d.truncated = false;
-    store_and_update(*state.agent.config, d);
-  }
+  to_return_transitions(episode_decisions, episode_decision_returns, config.dqn.gamma);
+  for (const Transition& d : episode_decisions) store_and_update(*state.agent.config, d);
   episode_decisions.clear();
-  episode_decision_returns.clear();
+}
+
+void to_return_transitions(std::vector<Transition>& decisions, std::vector<float>& r2, double gamma) {
+  to_decision_returns(r2, gamma);
+  for (std::size_t i = 0; i < decisions.size(); ++i) {
+    // Terminal: no bootstrap, so the segment's length (the discount's k) plays no part.
+    decisions[i].reward = r2[i];
+    decisions[i].terminated = true;
+    decisions[i].truncated = false;
+  }
+  r2.clear();
 }
 
 void store_and_update(rl::Learner& l, const Transition& t, int k) {
@@ -277,10 +280,10 @@ TrainerTiming Trainer::timing() const {
   if (m.config.trainer.simulation_threads > 1) {
     // The simulation threads' mean. The trainer's thread closes the rounds,
     // evaluates, checkpoints and logs while they wait: that moves from their
-    // waiting to its phases.
+    // waiting to its phases (the DQN learns on the learner thread).
     const auto n = static_cast<Clock::rep>(m.config.trainer.simulation_threads);
     for (int p = 0; p < kPhases; ++p) spent[p] = m.threads_spent[p] / n;
-    for (Phase p : {kHandover, kDqn, kEvaluation, kCheckpoint, kLogging}) {
+    for (Phase p : {kHandover, kEvaluation, kCheckpoint, kLogging}) {
       spent[kWaiting] -= m.laps.spent[p];
       spent[p] += m.laps.spent[p];
     }

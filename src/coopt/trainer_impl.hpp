@@ -44,6 +44,11 @@ void allocate_transitions(const CooptConfig& c, std::vector<Transition>& v, std:
 int random_valid_action(const std::vector<std::uint8_t>& mask, std::mt19937_64& rng);
 DecisionLog decision_log(int episode, int step, const rl::Action& a, float r2, const rl::Observation& next,
                          bool terminated, bool truncated, int k);
+// trainer.config_target: return: an ended episode's decisions, with their
+// segments' R2 in `r2`, become terminal transitions of the returns (each
+// segment's R2 plus the later ones, discounted by gamma once more each); r2 is
+// emptied.
+void to_return_transitions(std::vector<Transition>& decisions, std::vector<float>& r2, double gamma);
 // One transition into a learner, then the updates it asks for.
 void store_and_update(rl::Learner& l, const Transition& t, int k = 1);
 
