@@ -99,6 +99,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   f.add(pre + ".pilot_flat_steering", &p.pilot_flat_steering);
   f.add(pre + ".pilot_stair_steering", &p.pilot_stair_steering);
   f.add(pre + ".pilot_labels", &p.pilot_labels);
+  f.add(pre + ".motion_n_step", &p.motion_n_step, 1, 1000);
   f.add(pre + ".greedy_motion_interval", &p.greedy_motion_interval, 0, kMaxEpisodes);
   f.add(pre + ".config_learns_from", &p.config_learns_from);
   f.add(pre + ".config_target", &p.config_target);

@@ -139,6 +139,11 @@ struct TrainerParams {
   // behaviour-cloning target (td3.bc_weight), also where the motion model drove:
   // the pilot labels the states the learner visits (DAgger, Ross et al. 2011).
   bool pilot_labels = false;
+  // The motion transitions an actor hands over carry n-step returns
+  // (rl/n_step.hpp): the rewards of this step and the next n - 1, discounted
+  // by the motion learner's gamma, then its bootstrap discounted by gamma^n.
+  // 1 = one-step TD (the paper).
+  int motion_n_step = 1;
   // ground_truth (simulator labels) | classifier (ResNet-18 on depth)
   SceneSourceKind scene_source = SceneSourceKind::ground_truth;
   std::string classifier_dir;         // trained classifier directory (scene_source: classifier)

@@ -34,6 +34,12 @@ float state_scale(int i) {
 
 }  // namespace
 
+double motion_gamma(const CooptConfig& c) {
+  if (c.trainer.motion_algo == "td3") return c.td3.gamma;
+  if (c.trainer.motion_algo == "sac") return c.sac.gamma;
+  return 0.99;
+}
+
 rl::ObservationSpec motion_spec(const CooptConfig& c) {
   rl::ObservationSpec s;
   if (c.trainer.motion_image) {
@@ -155,7 +161,8 @@ void record_first_segment(const CooptConfig& c, const task::MultiTaskEnv& env, c
 }  // namespace
 
 EpisodeRunner::EpisodeRunner(const CooptConfig& config, std::function<int(int, int)> label_source)
-    : config_(config), env_(config.env), scene_(config) {
+    : config_(config), env_(config.env), scene_(config),
+      n_step_(config.trainer.motion_n_step, motion_gamma(config)) {
   scene_.label_source = std::move(label_source);
   allocate_buffers(config, b_);
 }
@@ -241,7 +248,10 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
     fill_motion(env, t, b.next);
     lap(kActing);
     const bool done = r->terminated || r->truncated;
-    if (hooks) hooks->motion(b.obs, b.action, static_cast<float>(r->reward), b.next, r->terminated, r->truncated);
+    if (hooks) {
+      n_step_.add(b.obs, b.action, static_cast<float>(r->reward), b.next, r->terminated, r->truncated, hooks->motion);
+      if (hooks->stepped) hooks->stepped(done);
+    }
     lap(kHandover);
     std::swap(b.obs, b.next);
     if (done) break;

@@ -20,6 +20,7 @@
 #include "perception/switch_detector.hpp"
 #include "rl/env.hpp"
 #include "rl/learner.hpp"
+#include "rl/n_step.hpp"
 #include "rl/policy.hpp"
 #include "task/multitask_env.hpp"
 #include "task/scripted_pilot.hpp"
@@ -56,6 +57,9 @@ struct Laps {
     last = now;
   }
 };
+
+// The discount of the motion learner's config (td3: or sac:; 0.99 for others).
+double motion_gamma(const CooptConfig& c);
 
 // The inputs of the two models.
 rl::ObservationSpec motion_spec(const CooptConfig& c);
@@ -115,7 +119,13 @@ struct Agent {
 
 // Training hooks of one episode (absent for evaluation).
 struct LearnHooks {
-  std::function<void(const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool)> motion;
+  // A motion transition to learn from: obs, action, return, next obs,
+  // terminated, truncated, and the control steps it sums (trainer.motion_n_step:
+  // it leaves up to n - 1 steps after its own, all of them at the episode's end).
+  std::function<void(const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool, int)>
+      motion;
+  // Every control step, after `motion`: whether the episode ended with it.
+  std::function<void(bool)> stepped;
   std::function<void(const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool, int)>
       config;
   std::function<int(const std::vector<std::uint8_t>&)> random_config;  // warm-up choice, -1 = ask the DQN
@@ -155,6 +165,7 @@ class EpisodeRunner {
   task::MultiTaskEnv env_;
   SceneSource scene_;
   Buffers b_;
+  rl::NStepReturns n_step_;  // the motion transitions' returns (trainer.motion_n_step)
 };
 
 }  // namespace comorph::coopt

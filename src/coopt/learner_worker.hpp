@@ -90,8 +90,10 @@ struct Transition {
   rl::Action action;
   float reward = 0;
   bool terminated = false, truncated = false;
+  int steps = 1;  // control steps it sums (trainer.motion_n_step); its discount is gamma^steps
   // Copies a step into this preallocated one (same sizes: no allocation).
-  void set(const rl::Observation& o, const rl::Action& a, float r, const rl::Observation& n, bool term, bool trunc) {
+  void set(const rl::Observation& o, const rl::Action& a, float r, const rl::Observation& n, bool term, bool trunc,
+           int k = 1) {
     obs.image = o.image;
     obs.vector = o.vector;
     next.image = n.image;
@@ -101,6 +103,7 @@ struct Transition {
     reward = r;
     terminated = term;
     truncated = trunc;
+    steps = k;
   }
 };
 

@@ -74,8 +74,10 @@ SimulationThread::SimulationThread(const CooptConfig& c, const std::function<int
     : runner(c, label_source) {
   agent.motion = make_motion_policy(c, static_cast<std::uint64_t>(c.trainer.seed) + 1);
   configure_pilot(c.trainer, pilot);
-  // The most steps a round can hold: its quota in steps of the shortest chain.
-  const int most = (round_quota(c.trainer) + step_cost(kMinModules) - 1) / step_cost(kMinModules);
+  // The most transitions a round can hold: its quota in steps of the shortest
+  // chain, and the n - 1 an n-step return held back from the round before.
+  const int most = (round_quota(c.trainer) + step_cost(kMinModules) - 1) / step_cost(kMinModules) +
+                   c.trainer.motion_n_step - 1;
   for (auto& p : pending) allocate_transitions(c, p, static_cast<std::size_t>(most));
 }
 
@@ -153,15 +155,16 @@ void Trainer::Impl::play_in_thread(SimulationThread& s, int episode) {
   if (s.agent.config_copy) s.agent.config_copy->reseed(stream_seed(t.seed, episode, 2));
   LearnHooks hooks;
   hooks.laps = &s.laps;
-  hooks.motion = [this, &s, learning = !plan.refit](const rl::Observation& o, const rl::Action& a, float r,
-                                                   const rl::Observation& n, bool term, bool trunc) {
-    if (learning) {
-      s.agent.motion->count(term, trunc);
-      s.pending[s.filling][static_cast<std::size_t>(s.stored++)].set(o, a, r, n, term, trunc);
-    }
+  hooks.motion = [&s, learning = !plan.refit](const rl::Observation& o, const rl::Action& a, float r,
+                                              const rl::Observation& n, bool term, bool trunc, int steps) {
+    if (!learning) return;
+    s.agent.motion->count(term, trunc);
+    s.pending[s.filling][static_cast<std::size_t>(s.stored++)].set(o, a, r, n, term, trunc, steps);
+  };
+  hooks.stepped = [this, &s](bool done) {
     ++s.round_steps;
     s.round_cost += step_cost(s.runner.env().modules());
-    if (s.round_cost >= round_quota(config.trainer) && !term && !trunc) await_release(*rounds, s, true);
+    if (s.round_cost >= round_quota(config.trainer) && !done) await_release(*rounds, s, true);
   };
   hooks.motion_greedy = plan.greedy_motion;
   hooks.config = [this, &s, episode, learns = plan.config_learns](const rl::Observation& o, const rl::Action& a,
@@ -279,7 +282,10 @@ void Trainer::Impl::end_round() {
     worker->submit([motion, dqn, &batches, &decisions, busy] {
       const Clock::time_point start = Clock::now();
       for (const Rounds::Batch& b : batches)
-        for (int i = 0; i < b.count; ++i) store_and_update(*motion, (*b.transitions)[static_cast<std::size_t>(i)]);
+        for (int i = 0; i < b.count; ++i) {
+          const Transition& t = (*b.transitions)[static_cast<std::size_t>(i)];
+          store_and_update(*motion, t, t.steps);
+        }
       for (const StoredDecision& d : decisions) store_and_update(*dqn, d.transition, d.k);
       *busy += Clock::now() - start;
     });

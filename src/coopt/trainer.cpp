@@ -112,7 +112,7 @@ void Trainer::Impl::hand_over() {
     const Clock::time_point start = Clock::now();
     for (int i = 0; i < n; ++i) {
       const Transition& t = (*batch)[i];
-      l->store(t.obs, t.action, t.reward, t.next, t.terminated, t.truncated);
+      l->store(t.obs, t.action, t.reward, t.next, t.terminated, t.truncated, t.steps);
       for (int u = l->updates_due(); u > 0; --u) l->update();
     }
     *busy += Clock::now() - start;
@@ -166,15 +166,14 @@ EpisodeLog Trainer::Impl::train_episode() {
   LearnHooks hooks;
   hooks.laps = &laps;
   if (plan.refit)
-    hooks.motion = [this](const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool) {
-      ++state.steps;
-    };
+    hooks.motion = [this](const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool,
+                          int) { ++state.steps; };
   else
     hooks.motion = [this](const rl::Observation& o, const rl::Action& a, float r, const rl::Observation& n,
-                          bool term, bool trunc) {
+                          bool term, bool trunc, int steps) {
       state.agent.motion->count(term, trunc);  // the acting side's exploration schedule
       Transition& tr = record ? (*record)[recorded++] : pending[filling][filled++];
-      tr.set(o, a, r, n, term, trunc);
+      tr.set(o, a, r, n, term, trunc, steps);
       ++state.steps;
       if (!record && filled == config.trainer.sync_interval) hand_over();
     };

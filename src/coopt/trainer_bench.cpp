@@ -38,7 +38,7 @@ SideRates measure_side_rates(const CooptConfig& config, std::int64_t steps) {
   std::size_t i = 0;
   bool learning = false;
   auto learn = [&](const Transition& tr) {
-    l.store(tr.obs, tr.action, tr.reward, tr.next, tr.terminated, tr.truncated);
+    l.store(tr.obs, tr.action, tr.reward, tr.next, tr.terminated, tr.truncated, tr.steps);
     int due = l.updates_due();
     learning = learning || due > 0;
     for (; due > 0; --due) l.update();

@@ -52,6 +52,7 @@ Td3Config Td3Config::from_yaml(const YAML::Node& node, const std::string& source
     add_linear_schedule(f, "exploration_noise", c.exploration_noise_start, c.exploration_noise_end,
                         c.exploration_noise_decay, 10.0);
     f.add("exploration_noise_unit", &c.exploration_noise_unit);
+    f.add("exploration_noise_correlation", &c.exploration_noise_correlation, 0.0, 0.9999);
     f.add("bc_weight", &c.bc_weight, 0.0, 1000.0);
     f.add("bc_decay_updates", &c.bc_decay_updates, std::int64_t(0), std::int64_t(1) << 40);
   });

@@ -147,6 +147,11 @@ struct Td3Config : ActorCriticNetworkConfig {
   double exploration_noise_end = 0.1;    // ... after the decay
   double exploration_noise_decay = 0;    // decay length; 0 = constant `end`
   NoiseDecayUnit exploration_noise_unit = NoiseDecayUnit::transitions;  // decay counted in transitions or episodes
+  // Correlation rho of the exploration noise (and of the random-action
+  // warm-up's actions) between consecutive steps of an episode: 0 = white;
+  // > 0 an AR(1) (Ornstein-Uhlenbeck) process of the same std per step that
+  // forgets over -1 / ln(rho) steps (0.98: about 50 steps). rl/td3.cpp.
+  double exploration_noise_correlation = 0;
   double max_grad_norm = 0;              // clip gradient L2 norms; 0 = off
   // Behaviour cloning towards the demonstrator's action of the transitions that
   // carry one (Action::target; TD3+BC, Fujimoto & Gu 2021):

@@ -43,7 +43,7 @@ torch::Tensor actor_features_of(ActorCritic& nets, const Observation& o, const O
 
 bool random_warmup_action(std::int64_t random_action_steps, std::int64_t random_action_episodes,
                           const LearnerCounters& n, bool explore, std::mt19937_64& rng, Action& action) {
-  if (!explore || (n.transitions >= random_action_steps && n.episodes >= random_action_episodes)) return false;
+  if (!explore || !in_random_warmup(random_action_steps, random_action_episodes, n)) return false;
   std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
   for (float& a : action.continuous) a = uniform(rng);
   return true;
@@ -54,7 +54,10 @@ void OffPolicyLearner::store(const Observation& o, const Action& action, float r
   replay_.add(o, action, reward, next, terminated,
               static_cast<float>(std::pow(schedule_.gamma, discount_steps(steps))));
   ++counters_.transitions;
-  if (terminated || truncated) ++counters_.episodes;
+  if (terminated || truncated) {
+    ++counters_.episodes;
+    acting_noise_.clear();
+  }
 }
 
 int OffPolicyLearner::updates_due() const {

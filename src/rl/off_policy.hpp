@@ -26,9 +26,14 @@ namespace comorph::rl {
 torch::Tensor gaussian_noise(std::int64_t rows, std::int64_t cols, double std, std::mt19937_64& rng,
                              const torch::Device& device);
 
-// An actor-critic config's random-action warm-up (random_action_steps
-// transitions or random_action_episodes episodes): while it lasts and the
-// caller explores, fills `action` uniformly in [-1, 1] and returns true.
+// Whether an actor-critic config's random-action warm-up (random_action_steps
+// transitions or random_action_episodes episodes) lasts at these counts.
+inline bool in_random_warmup(std::int64_t random_action_steps, std::int64_t random_action_episodes,
+                             const LearnerCounters& counters) {
+  return counters.transitions < random_action_steps || counters.episodes < random_action_episodes;
+}
+// While that warm-up lasts and the caller explores, fills `action`
+// uniformly in [-1, 1] and returns true.
 bool random_warmup_action(std::int64_t random_action_steps, std::int64_t random_action_episodes,
                           const LearnerCounters& counters, bool explore, std::mt19937_64& rng, Action& action);
 
@@ -149,6 +154,7 @@ class OffPolicyLearner : public Learner {
   torch::Device device_;
   ReplayBuffer replay_;
   std::mt19937_64 rng_;  // replay sampling, exploration, the algorithm's noise
+  std::vector<float> acting_noise_;  // act()'s noise state within an episode (Policy's noise_)
   LearnerCounters counters_;
   double last_loss_ = 0;
 

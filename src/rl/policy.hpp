@@ -18,6 +18,7 @@
 #include <random>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "rl/env.hpp"
 #include "rl/learner.hpp"
@@ -33,7 +34,10 @@ class Policy {
   // schedules (random-action warm-up, noise decay, epsilon) run on these counters.
   void count(bool terminated, bool truncated) {
     ++counters_.transitions;
-    if (terminated || truncated) ++counters_.episodes;
+    if (terminated || truncated) {
+      ++counters_.episodes;
+      noise_.clear();  // the next episode's exploration noise starts afresh
+    }
   }
   // Copies the learner's acting networks (Learner::acting_networks) into this copy.
   void sync_from(const Learner& learner);
@@ -45,7 +49,10 @@ class Policy {
   // A trainer with several acting copies sets their schedule's clock to the
   // whole run's counts, and each episode's random stream (coopt's simulation threads).
   void set_counters(const LearnerCounters& counters) { counters_ = counters; }
-  void reseed(std::uint64_t seed) { rng_.seed(seed); }
+  void reseed(std::uint64_t seed) {
+    rng_.seed(seed);
+    noise_.clear();
+  }
 
  protected:
   // `algorithm` and `networks_key` name the checkpoint's learner and the
@@ -57,6 +64,9 @@ class Policy {
 
   LearnerCounters counters_;
   std::mt19937_64 rng_;
+  // The acting rule's noise state within an episode (TD3's coloured
+  // exploration noise; empty at an episode's start, unused by the others).
+  std::vector<float> noise_;
 
  private:
   std::string algorithm_, key_, device_;
@@ -70,14 +80,14 @@ class NetworkPolicy final : public Policy {
  public:
   using Rule = void (*)(Net& net, const ObservationSpec& spec, int actions, const Config& config,
                         const torch::Device& device, const LearnerCounters& counters, std::mt19937_64& rng,
-                        const Observation& observation, bool explore, Action& action);
+                        std::vector<float>& noise, const Observation& observation, bool explore, Action& action);
   // `actions`: action dimensions (continuous) or count (discrete).
   NetworkPolicy(std::string algorithm, std::string networks_key, const ObservationSpec& spec, int actions,
                 const Config& config, std::uint64_t seed, Net net, Rule rule)
       : Policy(std::move(algorithm), std::move(networks_key), config.device, seed), spec_(spec), actions_(actions),
         config_(config), device_(config.device), net_(std::move(net)), rule_(rule) {}
   void act(const Observation& observation, bool explore, Action& action) override {
-    rule_(net_, spec_, actions_, config_, device_, counters_, rng_, observation, explore, action);
+    rule_(net_, spec_, actions_, config_, device_, counters_, rng_, noise_, observation, explore, action);
   }
 
  protected:

@@ -36,8 +36,8 @@ std::pair<torch::Tensor, torch::Tensor> sample_action(ActorCritic& nets, const S
 // The acting rule of the learner and of its Policy: uniform actions during the
 // random-action warm-up, else a sample of the squashed Gaussian (exploring) or its mean.
 void act_with(ActorCritic& nets, const ObservationSpec& spec, int action_dims, const SacConfig& c,
-              const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng, const Observation& o,
-              bool explore, Action& action) {
+              const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng,
+              std::vector<float>& /*noise: unused*/, const Observation& o, bool explore, Action& action) {
   act_continuous(c, action_dims, n, explore, rng, action, [&] {
     const torch::Tensor f = actor_features_of(nets, o, spec, device);
     if (explore) return sample_action(nets, c, action_dims, f, rng, device).first;
@@ -63,7 +63,7 @@ Sac::Sac(const ObservationSpec& observation, int action_dims, const SacConfig& c
 double Sac::alpha() const { return std::exp(log_alpha_.item<double>()); }
 
 void Sac::act(const Observation& o, bool explore, Action& action) {
-  act_with(nets_, spec_, action_dims_, config_, device_, counters_, rng_, o, explore, action);
+  act_with(nets_, spec_, action_dims_, config_, device_, counters_, rng_, acting_noise_, o, explore, action);
 }
 
 void Sac::update() {

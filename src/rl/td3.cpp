@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
 namespace comorph::rl {
 namespace {
@@ -20,17 +21,53 @@ double noise_std(const Td3Config& c, const LearnerCounters& n) {
   return LinearSchedule{c.exploration_noise_start, c.exploration_noise_end, c.exploration_noise_decay}.at(t);
 }
 
-// The acting rule of the learner and of its Policy: uniform actions during the
-// random-action warm-up, else tanh(actor) plus clipped Gaussian noise when exploring.
+// One step of the exploration noise's unit process in `z` (one value per
+// action dimension): white, or with correlation rho > 0 the AR(1) process
+// z' = rho z + sqrt(1 - rho^2) e, e ~ N(0, 1), whose values are N(0, 1) at
+// every step (an empty `z` starts from that distribution) and whose
+// correlation decays over -1 / ln(rho) steps (Ornstein-Uhlenbeck sampled at
+// the control interval). Held for many steps, a correlated draw explores what
+// a sustained action does (a stair gait), which white noise averages away.
+void step_unit_noise(double rho, int action_dims, std::mt19937_64& rng, std::vector<float>& z) {
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  if (z.empty()) {
+    z.resize(static_cast<std::size_t>(action_dims));
+    for (float& v : z) v = normal(rng);
+    return;
+  }
+  const auto r = static_cast<float>(rho), innovation = static_cast<float>(std::sqrt(1.0 - rho * rho));
+  for (float& v : z) v = r * v + innovation * normal(rng);
+}
+
+// The acting rule of the learner and of its Policy: random actions during the
+// random-action warm-up, else tanh(actor) plus clipped noise when exploring.
+// With exploration_noise_correlation 0 both are white (uniform actions,
+// Gaussian noise); with rho > 0 both follow the AR(1) process above (the
+// warm-up's action erf(z / sqrt 2) is uniform in [-1, 1] at every step).
 void act_with(ActorCritic& nets, const ObservationSpec& spec, int action_dims, const Td3Config& c,
-              const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng, const Observation& o,
-              bool explore, Action& action) {
+              const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng, std::vector<float>& noise,
+              const Observation& o, bool explore, Action& action) {
+  const double rho = c.exploration_noise_correlation;
+  if (explore && rho > 0 && in_random_warmup(c.random_action_steps, c.random_action_episodes, n)) {
+    action.continuous.resize(static_cast<std::size_t>(action_dims));
+    step_unit_noise(rho, action_dims, rng, noise);
+    for (int i = 0; i < action_dims; ++i)
+      action.continuous[i] = static_cast<float>(std::erf(noise[i] / std::sqrt(2.0)));
+    return;
+  }
   const bool from_actor = act_continuous(c, action_dims, n, explore, rng, action, [&] {
     return torch::tanh(nets->actor_head(actor_features_of(nets, o, spec, device)));
   });
   if (!from_actor || !explore) return;
-  std::normal_distribution<float> normal(0.0f, static_cast<float>(noise_std(c, n)));
-  for (float& v : action.continuous) v = std::clamp(v + normal(rng), -1.0f, 1.0f);
+  if (rho <= 0) {
+    std::normal_distribution<float> normal(0.0f, static_cast<float>(noise_std(c, n)));
+    for (float& v : action.continuous) v = std::clamp(v + normal(rng), -1.0f, 1.0f);
+    return;
+  }
+  step_unit_noise(rho, action_dims, rng, noise);
+  const auto std = static_cast<float>(noise_std(c, n));
+  for (int i = 0; i < action_dims; ++i)
+    action.continuous[i] = std::clamp(action.continuous[i] + std * noise[i], -1.0f, 1.0f);
 }
 
 }  // namespace
@@ -54,7 +91,7 @@ double Td3::bc_weight_now() const {
 }
 
 void Td3::act(const Observation& o, bool explore, Action& action) {
-  act_with(nets_, spec_, action_dims_, config_, device_, counters_, rng_, o, explore, action);
+  act_with(nets_, spec_, action_dims_, config_, device_, counters_, rng_, acting_noise_, o, explore, action);
 }
 
 void Td3::update() {

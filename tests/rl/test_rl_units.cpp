@@ -13,6 +13,7 @@
 #include "rl/classic/pendulum.hpp"
 #include "rl/dqn.hpp"
 #include "rl/flat_adam.hpp"
+#include "rl/n_step.hpp"
 #include "rl/networks.hpp"
 #include "rl/replay_buffer.hpp"
 #include "rl/sac.hpp"
@@ -478,6 +479,138 @@ TEST(Td3, ExplorationNoiseDecaysPerEpisode) {
   EXPECT_NEAR(td3.exploration_noise(), 0.07, 1e-12);
   for (int i = 0; i < 3; ++i) td3.store(vector_obs({0}), a, 0, vector_obs({0}), true, false);
   EXPECT_NEAR(td3.exploration_noise(), 0.02, 1e-12);
+}
+
+// Exploration noise of one policy over an episode of `steps` steps on a fixed
+// observation: the action minus the greedy action, per step, dimension 0.
+std::vector<double> exploration_deviations(double correlation, int steps, bool warmup) {
+  rl::Td3Config c;
+  c.hidden_sizes = {8};
+  c.random_action_steps = warmup ? 1000000 : 0;
+  c.exploration_noise_start = c.exploration_noise_end = 0.2;
+  c.exploration_noise_correlation = correlation;
+  const auto policy = rl::Td3::policy({0, 0, 0, 1}, 2, c, 7);
+  rl::Action greedy, a;
+  policy->act(vector_obs({0.3f}), false, greedy);
+  std::vector<double> d;
+  for (int t = 0; t < steps; ++t) {
+    policy->act(vector_obs({0.3f}), true, a);
+    d.push_back(warmup ? a.continuous[0] : a.continuous[0] - greedy.continuous[0]);
+    policy->count(false, false);
+  }
+  return d;
+}
+
+// Lag-1 correlation and standard deviation of a series.
+std::pair<double, double> lag1_and_std(const std::vector<double>& x) {
+  double mean = 0;
+  for (double v : x) mean += v;
+  mean /= static_cast<double>(x.size());
+  double var = 0, cov = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    var += (x[i] - mean) * (x[i] - mean);
+    if (i > 0) cov += (x[i] - mean) * (x[i - 1] - mean);
+  }
+  return {cov / var, std::sqrt(var / static_cast<double>(x.size()))};
+}
+
+// White noise (correlation 0) is what TD3 always drew; with rho the noise
+// keeps its std but follows an AR(1) process with lag-1 correlation rho, and
+// the random-action warm-up stays uniform in [-1, 1] (std 1 / sqrt 3).
+TEST(Td3, CorrelatedExplorationNoiseKeepsItsStdAndHasTheAskedCorrelation) {
+  for (double rho : {0.0, 0.9, 0.98}) {
+    // One episode of 20 000 steps.
+    const auto [lag1, std] = lag1_and_std(exploration_deviations(rho, 20000, false));
+    EXPECT_NEAR(lag1, rho, 0.02) << "rho " << rho;
+    EXPECT_NEAR(std, 0.2, rho > 0.95 ? 0.03 : 0.01) << "rho " << rho;
+    const auto [warm_lag1, warm_std] = lag1_and_std(exploration_deviations(rho, 20000, true));
+    EXPECT_NEAR(warm_std, 1.0 / std::sqrt(3.0), rho > 0.95 ? 0.05 : 0.02) << "rho " << rho;
+    EXPECT_GT(warm_lag1, rho - 0.05) << "rho " << rho;
+    EXPECT_LT(warm_lag1, rho + 0.05) << "rho " << rho;
+  }
+}
+
+TEST(Td3, CorrelatedNoiseStartsAfreshEachEpisode) {
+  rl::Td3Config c;
+  c.hidden_sizes = {8};
+  c.random_action_steps = 0;
+  c.exploration_noise_correlation = 0.99;
+  // Three policies of one seed draw the same numbers. `ended` ends an episode
+  // after its 5th step, `fresh` after every step, `running` never: at the 6th
+  // step the first two start from a fresh draw, the third continues its process.
+  const auto ended = rl::Td3::policy({0, 0, 0, 1}, 2, c, 3);
+  const auto fresh = rl::Td3::policy({0, 0, 0, 1}, 2, c, 3);
+  const auto running = rl::Td3::policy({0, 0, 0, 1}, 2, c, 3);
+  rl::Action x, y, z;
+  for (int t = 0; t < 6; ++t) {
+    ended->act(vector_obs({0}), true, x);
+    fresh->act(vector_obs({0}), true, y);
+    running->act(vector_obs({0}), true, z);
+    ended->count(false, t == 4);
+    fresh->count(true, false);
+    running->count(false, false);
+  }
+  EXPECT_EQ(x.continuous, y.continuous);
+  EXPECT_NE(x.continuous, z.continuous);
+}
+
+// n-step returns: each transition sums n rewards, discounted, and bootstraps
+// from the state n steps on; the episode's end flushes the rest with fewer.
+TEST(NStepReturns, SumsNRewardsAndFlushesAtTheEpisodeEnd) {
+  struct Out {
+    float obs, reward, next;
+    bool terminated, truncated;
+    int steps;
+  };
+  for (bool truncate : {false, true}) {
+    rl::NStepReturns n_step(3, 0.5);
+    std::vector<Out> out;
+    auto emit = [&](const rl::Observation& o, const rl::Action& a, float r, const rl::Observation& n, bool term,
+                    bool trunc, int steps) {
+      EXPECT_EQ(a.continuous[0], o.vector[0] * 10);
+      out.push_back({o.vector[0], r, n.vector[0], term, trunc, steps});
+    };
+    rl::Action a;
+    for (int t = 0; t < 5; ++t) {
+      a.continuous = {static_cast<float>(t) * 10};
+      const bool end = t == 4;
+      n_step.add(vector_obs({static_cast<float>(t)}), a, static_cast<float>(t + 1), vector_obs({static_cast<float>(t + 1)}),
+                 end && !truncate, end && truncate, emit);
+      EXPECT_EQ(out.size(), end ? 5u : static_cast<std::size_t>(std::max(0, t - 1)));
+    }
+    EXPECT_EQ(n_step.pending(), 0);
+    // Rewards 1..5; returns r_t + 0.5 r_t+1 + 0.25 r_t+2.
+    const std::vector<Out> want = {{0, 1 + 1.0f + 0.75f, 3, false, false, 3},
+                                   {1, 2 + 1.5f + 1.0f, 4, false, false, 3},
+                                   {2, 3 + 2.0f + 1.25f, 5, !truncate, truncate, 3},
+                                   {3, 4 + 2.5f, 5, !truncate, truncate, 2},
+                                   {4, 5, 5, !truncate, truncate, 1}};
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      EXPECT_EQ(out[i].obs, want[i].obs) << i;
+      EXPECT_FLOAT_EQ(out[i].reward, want[i].reward) << i;
+      EXPECT_EQ(out[i].next, want[i].next) << i;
+      EXPECT_EQ(out[i].terminated, want[i].terminated) << i;
+      EXPECT_EQ(out[i].truncated, want[i].truncated) << i;
+      EXPECT_EQ(out[i].steps, want[i].steps) << i;
+    }
+  }
+}
+
+TEST(NStepReturns, OneStepPassesTransitionsThrough) {
+  rl::NStepReturns n_step(1, 0.99);
+  rl::Action a;
+  a.continuous = {0.5f};
+  int calls = 0;
+  n_step.add(vector_obs({1}), a, 2.0f, vector_obs({3}), false, false,
+             [&](const rl::Observation& o, const rl::Action&, float r, const rl::Observation& n, bool, bool, int k) {
+               ++calls;
+               EXPECT_EQ(o.vector[0], 1);
+               EXPECT_EQ(r, 2.0f);
+               EXPECT_EQ(n.vector[0], 3);
+               EXPECT_EQ(k, 1);
+             });
+  EXPECT_EQ(calls, 1);
+  EXPECT_THROW(rl::NStepReturns(0, 0.99), std::invalid_argument);
 }
 
 // Behaviour cloning: every transition ends with reward 1 whatever the action,
