@@ -45,7 +45,11 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
                  "drive a fixed chain of this many modules with the run's motion model (no configuration model, "
                  "no shedding): what the motion model can do with each body; writes eval-<scenario>-modules<N>.*")
       ->check(comorph::cli::whole_in(comorph::kMinModules, comorph::kMaxModules));
-  ev->callback([] { comorph::workflows::eval_run(run, scenario, episodes, seed, workers, forced_modules); });
+  static bool pilot_drives = false;
+  ev->add_flag("--pilot", pilot_drives,
+               "the scripted pilot drives (as the run's training configured it, without noise) instead of the motion "
+               "model: the hand-written controller's figures; writes eval-<scenario>[-modules<N>]-pilot.*");
+  ev->callback([] { comorph::workflows::eval_run(run, scenario, episodes, seed, workers, forced_modules, pilot_drives); });
 
   auto* ex = app.add_subcommand("export", "copy a trained run's policies (no replay buffers) and logs, e.g. into results/");
   static std::string export_run, export_out;

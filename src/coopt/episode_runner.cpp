@@ -160,6 +160,15 @@ void record_first_segment(const CooptConfig& c, const task::MultiTaskEnv& env, c
 
 }  // namespace
 
+void configure_pilot(const TrainerParams& t, task::ScriptedPilot& pilot) {
+  if (t.pilot_gait_per_modules)
+    pilot.params() = task::searched_stair_gaits();
+  else
+    pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};  // the gait the physics-table search picks
+  pilot.params().flat_steering = t.pilot_flat_steering;
+  pilot.params().stair_steering = t.pilot_stair_steering;
+}
+
 EpisodeRunner::EpisodeRunner(const CooptConfig& config, std::function<int(int, int)> label_source)
     : config_(config), env_(config.env), scene_(config),
       n_step_(config.trainer.motion_n_step, motion_gamma(config)) {
@@ -230,10 +239,12 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
       control::MotionMode pilot_mode;
       b.action.target.resize(control::kActionSize);  // sized once: no allocation after the first step
       pilot->act(env, b.action.target.data(), pilot_mode);
-      if (hooks->pilot_drives) {
+      if (hooks->pilot_drives && hooks->pilot_noise > 0) {
         std::normal_distribution<float> noise(0.0f, static_cast<float>(hooks->pilot_noise));
         for (int i = 0; i < control::kActionSize; ++i)
           b.action.continuous[i] = std::clamp(b.action.target[i] + noise(*hooks->pilot_rng), -1.0f, 1.0f);
+      } else if (hooks->pilot_drives) {
+        b.action.continuous = b.action.target;
       }
     } else {
       b.action.target.clear();

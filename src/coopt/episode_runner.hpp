@@ -141,6 +141,9 @@ struct LearnHooks {
   Laps* laps = nullptr;  // the trainer's timing (TrainerTiming)
 };
 
+// The scripted pilot as trainer.pilot_* set it: its stair gaits and steering.
+void configure_pilot(const TrainerParams& t, task::ScriptedPilot& pilot);
+
 // Reusable buffers of an episode (no allocation in the step loop).
 struct Buffers {
   rl::Observation obs, next, cobs, cnext;

@@ -44,15 +44,24 @@ void load_greedy_agent(const CooptConfig& c, const CheckpointInfo& checkpoint, A
 struct GreedyPlayer {
   EpisodeRunner runner;
   Agent agent;
+  task::ScriptedPilot pilot;
+  LearnHooks pilot_hooks;  // learn nothing; the pilot drives (EvalRequest::pilot_drives)
+  bool pilot_drives = false;
 
-  GreedyPlayer(const CooptConfig& c, const CheckpointInfo& checkpoint) : runner(c) {
+  GreedyPlayer(const CooptConfig& c, const CheckpointInfo& checkpoint, bool pilot_drives = false)
+      : runner(c), pilot_drives(pilot_drives) {
     load_greedy_agent(c, checkpoint, agent);
+    configure_pilot(c.trainer, pilot);
+    pilot_hooks.motion = [](const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool, int) {};
+    pilot_hooks.config = [](const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool, int) {};
+    pilot_hooks.pilot = &pilot;
+    pilot_hooks.pilot_drives = true;
   }
 
   // Episode `index` of an evaluation of `scenario` (spec from eval_spec).
   EpisodeLog play_episode(const task::ScenarioSpec& scenario, const task::EpisodeSpec& spec, int index,
                           const StepObserver* observe = nullptr) {
-    EpisodeLog log = runner.play(agent, spec, false, nullptr, observe);
+    EpisodeLog log = runner.play(agent, spec, false, pilot_drives ? &pilot_hooks : nullptr, observe);
     log.episode = index;
     log.scenario = scenario.name;
     return log;
@@ -81,7 +90,7 @@ std::vector<EpisodeLog> evaluate(const CooptConfig& run_config, const std::strin
   int finished = 0;
   auto work = [&] {
     try {
-      GreedyPlayer player(config, info);
+      GreedyPlayer player(config, info, request.pilot_drives);
       for (int i = next++; i < request.episodes; i = next++) {
         const auto spec = eval_spec(config, scenario, static_cast<std::uint64_t>(request.seed) + i, i);
         logs[static_cast<std::size_t>(i)] = player.play_episode(scenario, spec, i);

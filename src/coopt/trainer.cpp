@@ -35,15 +35,6 @@ void allocate_transitions(const CooptConfig& c, std::vector<Transition>& v, std:
   }
 }
 
-void configure_pilot(const TrainerParams& t, task::ScriptedPilot& pilot) {
-  if (t.pilot_gait_per_modules)
-    pilot.params() = task::searched_stair_gaits();
-  else
-    pilot.params().gait = {1.0f, 1.0f, -0.5f, 1.0f};  // the gait the physics-table search picks
-  pilot.params().flat_steering = t.pilot_flat_steering;
-  pilot.params().stair_steering = t.pilot_stair_steering;
-}
-
 EpisodePlan plan_episode(const TrainerParams& t, int episode) {
   EpisodePlan p;
   p.warmup = episode < t.warmup_episodes;

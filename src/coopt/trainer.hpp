@@ -207,6 +207,11 @@ struct EvalRequest {
   int forced_modules = 0;            // > 0: the run's motion model drives a fixed chain of this many
                                      // modules (configuration model unused, no shedding): what the
                                      // motion model can do with each body
+  // The run's scripted pilot (task::ScriptedPilot as the run's trainer
+  // configures it: its gaits and steering, no noise) drives instead of the
+  // motion model: the hand-written controller's own figures, beside the
+  // learned ones (with forced_modules: each chain).
+  bool pilot_drives = false;
   // Called after each finished episode with the number finished so far (one
   // call at a time, from the worker that finished it): progress for the CLI.
   std::function<void(int finished, int episodes)> on_episode_finished;

@@ -37,7 +37,6 @@ struct EpisodePlan {
   task::EpisodeSpec spec;      // the scene (seed from trainer.seed and the index)
 };
 EpisodePlan plan_episode(const TrainerParams& t, int episode);
-void configure_pilot(const TrainerParams& t, task::ScriptedPilot& pilot);
 // `n` hand-over transitions of the motion model's sizes (copies into them do not allocate).
 void allocate_transitions(const CooptConfig& c, std::vector<Transition>& v, std::size_t n);
 // A uniform choice among the mask's valid actions (-1 when none).

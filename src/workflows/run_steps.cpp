@@ -111,7 +111,7 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
 }
 
 report::EvalSummary eval_run(const std::string& run_dir, const std::string& scenario, int episodes, int seed,
-                         int workers, int forced_modules) {
+                         int workers, int forced_modules, bool pilot_drives) {
   const std::string path = (fs::path(run_dir) / "config.yaml").string();
   if (!fs::exists(path)) throw std::runtime_error(run_dir + ": not a training run (no config.yaml)");
   const CooptConfig config = comorph::coopt::load_coopt_config(path);
@@ -122,6 +122,7 @@ report::EvalSummary eval_run(const std::string& run_dir, const std::string& scen
   request.workers = workers > 0 ? workers : config.eval.workers;
   if (request.workers == 0) request.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   request.forced_modules = forced_modules;
+  request.pilot_drives = pilot_drives;
   // A progress line on stderr every 30 s and at the end: 300 episodes take minutes.
   const auto started = std::chrono::steady_clock::now();
   auto last_line = started;
@@ -139,7 +140,8 @@ report::EvalSummary eval_run(const std::string& run_dir, const std::string& scen
   for (const auto& l : logs) records.push_back(to_record(l));
   const auto m = comorph::report::summarize(records, f_weights(config));
   const std::string name =
-      "eval-" + scenario + (forced_modules > 0 ? "-modules" + std::to_string(forced_modules) : std::string());
+      "eval-" + scenario + (forced_modules > 0 ? "-modules" + std::to_string(forced_modules) : std::string()) +
+      (pilot_drives ? "-pilot" : "");
   const std::string json = (fs::path(run_dir) / (name + ".json")).string();
   const std::string csv = (fs::path(run_dir) / (name + "-episodes.csv")).string();
   comorph::report::write_metrics_json(json, m);
@@ -147,7 +149,9 @@ report::EvalSummary eval_run(const std::string& run_dir, const std::string& scen
 
   std::printf("%s, scenario %s: %d greedy episodes (seeds %d..%d)%s\n", run_dir.c_str(), scenario.c_str(),
               request.episodes, request.seed, request.seed + request.episodes - 1,
-              forced_modules > 0 ? fmt::format(", forced chain of {} modules", forced_modules).c_str() : "");
+              (std::string(forced_modules > 0 ? fmt::format(", forced chain of {} modules", forced_modules) : "") +
+               (pilot_drives ? ", driven by the scripted pilot" : ""))
+                  .c_str());
   std::printf("%-8s %-9s %s\n", "stairs", "success", "configurations (episodes)");
   for (const std::string& key : comorph::report::paper_stair_keys()) {
     std::string seqs;

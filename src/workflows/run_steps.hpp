@@ -32,8 +32,10 @@ void clear_run_dir(const std::string& dir);
 // the run config's eval section. forced_modules > 0: the run's motion model
 // drives a fixed chain of that many modules (EvalRequest::forced_modules);
 // the files are then eval-<scenario>-modules<N>.json and -episodes.csv.
+// pilot_drives: the run's scripted pilot drives (EvalRequest::pilot_drives),
+// and the names end in -pilot.
 report::EvalSummary eval_run(const std::string& run_dir, const std::string& scenario, int episodes, int seed,
-                         int workers, int forced_modules = 0);
+                         int workers, int forced_modules = 0, bool pilot_drives = false);
 
 // Copies what `eval`, `render` and `report` need of a trained run into `out`
 // (config.yaml, run.yaml, episodes.csv rounded to the report's digits,

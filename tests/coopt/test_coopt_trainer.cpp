@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "coopt/config.hpp"
+#include "coopt/episode_runner.hpp"
 #include "coopt/segment.hpp"
 #include "coopt/trainer.hpp"
 #include "perception/params.hpp"
@@ -575,6 +576,39 @@ TEST(Evaluate, GreedyEpisodesCycleHeightsAndDoNotDependOnWorkers) {
       EXPECT_GT(l.first_segment_steps, 0);  // also logged without a configuration model
     }
   }
+  // The pilot drives: each episode is the one the scripted pilot drives alone
+  // through the same scene source (motion modes from the switch detector).
+  req.forced_modules = 5;
+  req.pilot_drives = true;
+  req.episodes = 3;
+  const std::vector<EpisodeLog> piloted = evaluate(c, dir, req);
+  for (int i = 0; i < req.episodes; ++i) {
+    task::MultiTaskEnv env(c.env);
+    task::EpisodeSpec spec = eval_spec(c, task::scenario_named("default"), static_cast<std::uint64_t>(req.seed + i), i);
+    spec.configuration = make_chain(5);
+    env.reset(spec);
+    SceneSource scene(c);
+    scene.reset(env);
+    task::ScriptedPilot pilot;
+    configure_pilot(c.trainer, pilot);
+    pilot.plan(env);
+    float action[control::kActionSize];
+    control::MotionMode pilot_mode;
+    double ret = 0;
+    while (true) {
+      pilot.act(env, action, pilot_mode);
+      const task::StepOutcome& r = env.step(
+          action, scene.current() == sim::kLabelStairs ? control::MotionMode::stair : control::MotionMode::flat);
+      ret += r.reward;
+      if (r.terminated || r.truncated) break;
+      scene.step(env);
+    }
+    EXPECT_EQ(piloted[i].steps, env.step_count()) << i;
+    EXPECT_DOUBLE_EQ(piloted[i].return_R1, ret) << i;
+    EXPECT_EQ(piloted[i].configurations, std::vector<int>{5});
+  }
+  req.pilot_drives = false;
+  EXPECT_NE(line_of(evaluate(c, dir, req)[0]), line_of(piloted[0]));  // the motion model drives otherwise
   req.forced_modules = kMaxModules + 1;
   EXPECT_THROW(evaluate(c, dir, req), std::invalid_argument);
   fs::remove_all(dir);
