@@ -55,6 +55,7 @@ Td3Config Td3Config::from_yaml(const YAML::Node& node, const std::string& source
     f.add("exploration_noise_correlation", &c.exploration_noise_correlation, 0.0, 0.9999);
     f.add("bc_weight", &c.bc_weight, 0.0, 1000.0);
     f.add("bc_decay_updates", &c.bc_decay_updates, std::int64_t(0), std::int64_t(1) << 40);
+    f.add("actor_q_weight", &c.actor_q_weight, 0.0, 1.0);
   });
 }
 

@@ -159,6 +159,10 @@ struct Td3Config : ActorCriticNetworkConfig {
   // bc_decay_updates actor updates (0 = constant). bc_weight 0 = plain TD3.
   double bc_weight = 0;
   std::int64_t bc_decay_updates = 0;
+  // Weight of the Q term in that actor loss: 1 = TD3 (+BC); 0 = the actor
+  // imitates the targets alone (behaviour cloning on the replay; the critics
+  // still learn, unused): what the critic adds to the imitation.
+  double actor_q_weight = 1;
 
   static Td3Config from_yaml(const YAML::Node& node, const std::string& source);
 };

@@ -132,10 +132,12 @@ void Td3::update_with_autograd(const ReplayBatch& b, const torch::Tensor& smooth
       // Q normalised by its batch magnitude, so that w means the same at any reward scale.
       const double w = bc_weight_now();
       actor_loss = -q.mean() / q.abs().mean().detach().clamp_min(1e-6);
+      if (config_.actor_q_weight != 1) actor_loss = config_.actor_q_weight * actor_loss;
       if (w > 0)
         actor_loss = actor_loss + w * ((pi - b.target).pow(2).sum(1) * b.has_target).mean();
     } else {
       actor_loss = -q.mean();
+      if (config_.actor_q_weight != 1) actor_loss = config_.actor_q_weight * actor_loss;
     }
     gradient_step(*actor_optimizer_, actor_loss, config_.max_grad_norm);
     actor_step_done();
@@ -192,7 +194,8 @@ void Td3::update_with_explicit_passes(const ReplayBatch& b, const torch::Tensor&
   const torch::Tensor q = q_of(nets_->critic1);
   // d loss / d q of -mean(q) [/ mean|q|], in autograd's order: divide, negate, spread over the batch.
   const double w = config_.bc_weight > 0 ? bc_weight_now() : 0.0;
-  const torch::Tensor d_mean = config_.bc_weight > 0 ? (e.one / q.abs().mean().clamp_min(1e-6)).neg() : -e.one;
+  torch::Tensor d_mean = config_.bc_weight > 0 ? (e.one / q.abs().mean().clamp_min(1e-6)).neg() : -e.one;
+  if (config_.actor_q_weight != 1) d_mean = d_mean * config_.actor_q_weight;
   e.q_grad.copy_(d_mean.expand({batch})).div_(batch);
   e.critic.backward(e.q_grad.view({batch, 1}), /*parameter_grads=*/false, /*input_grad=*/true);
   torch::Tensor d_pi = e.critic.input_grad().narrow(1, obs, act);

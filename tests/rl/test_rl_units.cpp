@@ -655,6 +655,43 @@ TEST(Td3, BehaviourCloningPullsTheActorToTheDemonstratedActions) {
   EXPECT_GT(without, 0.2);
 }
 
+// actor_q_weight 0 takes the critic out of the actor's loss: with no
+// demonstrations the actor then does not move, while TD3 (weight 1) finds the
+// action the reward prefers (one-step episodes, reward -(a - 0.6)^2).
+TEST(Td3, ActorQWeightZeroLeavesTheActorToImitationAlone) {
+  for (double q_weight : {1.0, 0.0}) {
+    rl::Td3Config c;
+    c.hidden_sizes = {32, 32};
+    c.batch_size = 64;
+    c.buffer_size = 1000;
+    c.learning_starts = 0;
+    c.random_action_steps = 0;
+    c.policy_delay = 1;
+    c.actor_learning_rate = 3e-3;
+    c.bc_weight = q_weight == 0 ? 1.0 : 0.0;  // with 0: the imitation term alone, but nothing carries a target
+    c.actor_q_weight = q_weight;
+    rl::Td3 td3({0, 0, 0, 1}, 1, c, 3);
+    rl::Action a, before, after;
+    td3.act(vector_obs({0.2f}), false, before);
+    std::mt19937_64 rng(1);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    for (int i = 0; i < 400; ++i) {
+      a.continuous = {u(rng)};
+      td3.store(vector_obs({0.2f}), a, -(a.continuous[0] - 0.6f) * (a.continuous[0] - 0.6f), vector_obs({0.2f}),
+                true, false);
+    }
+    for (int update = 0; update < 1500; ++update) td3.update();
+    td3.act(vector_obs({0.2f}), false, after);
+    if (q_weight == 0) {
+      EXPECT_EQ(after.continuous, before.continuous);
+    } else {
+      // From about 0 at initialisation to most of the way.
+      EXPECT_GT(std::abs(before.continuous[0] - 0.6f), 0.4f);
+      EXPECT_LT(std::abs(after.continuous[0] - 0.6f), 0.2f);
+    }
+  }
+}
+
 // TD3's explicit passes (rl/mlp_pass.hpp) compute what autograd computes,
 // bit for bit: two learners of one seed, one forced onto autograd, train on the
 // same transitions and end with equal networks, targets, optimizer states and
@@ -681,6 +718,7 @@ struct ExplicitPassCase {
   double bc_weight;
   double max_grad_norm;
   std::vector<int> hidden;
+  double actor_q_weight = 1;
 };
 
 class Td3ExplicitPasses : public ::testing::TestWithParam<ExplicitPassCase> {};
@@ -695,6 +733,7 @@ TEST_P(Td3ExplicitPasses, EqualAutogradBitForBit) {
   c.bc_weight = GetParam().bc_weight;
   c.bc_decay_updates = 150;
   c.max_grad_norm = GetParam().max_grad_norm;
+  c.actor_q_weight = GetParam().actor_q_weight;
   c.actor_learning_rate = c.critic_learning_rate = 3e-3;
   rl::Td3 explicit_passes({0, 0, 0, 3}, 2, c, 5), autograd({0, 0, 0, 3}, 2, c, 5);
   autograd.force_autograd(true);
@@ -729,7 +768,8 @@ TEST_P(Td3ExplicitPasses, EqualAutogradBitForBit) {
 
 INSTANTIATE_TEST_SUITE_P(Cases, Td3ExplicitPasses,
                          ::testing::Values(ExplicitPassCase{0.0, 0.0, {16, 16}}, ExplicitPassCase{2.5, 0.0, {16, 16}},
-                                           ExplicitPassCase{2.5, 1.0, {16, 16}}, ExplicitPassCase{0.0, 0.5, {8}}));
+                                           ExplicitPassCase{2.5, 1.0, {16, 16}}, ExplicitPassCase{0.0, 0.5, {8}},
+                                           ExplicitPassCase{2.5, 0.0, {16, 16}, 0.0}));
 
 // sample_into reuses its batch's tensors and returns what sample() returns
 // for the same draws, terminated transitions and targets included.
