@@ -78,7 +78,7 @@ struct PilotParams {
 };
 
 // The pilot with the stair gaits of a search over a0 x a2=a4 x a3 per chain
-// length (docs/results.md): the shared gait, and 3 modules' own.
+// length (docs/history.md): the shared gait, and 3 modules' own.
 PilotParams searched_stair_gaits();
 
 }  // namespace comorph::task
