@@ -104,6 +104,7 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   f.add(pre + ".config_learns_from", &p.config_learns_from);
   f.add(pre + ".config_target", &p.config_target);
   f.add(pre + ".config_refit_episodes", &p.config_refit_episodes, 0, kMaxEpisodes);
+  f.add(pre + ".refit_motion_from", &p.refit_motion_from);
   f.add(pre + ".scene_source", &p.scene_source);
   f.add(pre + ".classifier_dir", &p.classifier_dir);
   f.add(pre + ".scenario", &p.scenario);
@@ -124,9 +125,15 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   }
   if (p.config_learns_from == ConfigLearnsFrom::greedy && p.greedy_motion_interval < 1)
     fail(source, pre + ".config_learns_from", "greedy needs trainer.greedy_motion_interval >= 1");
-  // A run without a single episode would end at once with no checkpoint to resume or evaluate.
-  if (p.warmup_episodes + p.episodes < 1)
+  if (!p.refit_motion_from.empty()) {
+    if (p.warmup_episodes != 0 || p.episodes != 0 || p.config_refit_episodes < 1)
+      fail(source, pre + ".refit_motion_from",
+           "a refit of another run's motion model needs trainer.warmup_episodes 0, trainer.episodes 0 and "
+           "trainer.config_refit_episodes >= 1");
+  } else if (p.warmup_episodes + p.episodes < 1) {
+    // A run without a single episode would end at once with no checkpoint to resume or evaluate.
     fail(source, pre + ".episodes", "warmup_episodes + episodes must be at least 1");
+  }
   if (p.config_refit_episodes > 0 && p.mode != TrainerMode::hierarchical)
     fail(source, pre + ".config_refit_episodes", "needs trainer.mode hierarchical (a fixed chain has no DQN)");
   if (p.scene_source == SceneSourceKind::classifier) {

@@ -132,6 +132,12 @@ struct TrainerParams {
   // motion model; during training they mix every stage of it, and the early
   // ones stay in its replay. 0 = none.
   int config_refit_episodes = 0;
+  // A trained run directory whose motion model (its latest checkpoint's) this
+  // run takes, frozen, to do only a refit: warmup_episodes and episodes 0,
+  // config_refit_episodes > 0. Another configuration model for a motion model
+  // already trained (other refit settings, another R2) without training it
+  // again. The run copies the weights into its own checkpoints at its start.
+  std::string refit_motion_from;
   // Episode index of the refit's first episode (= warm-up + training episodes).
   int refit_start() const { return warmup_episodes + episodes; }
   int total_episodes() const { return refit_start() + config_refit_episodes; }

@@ -9,6 +9,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 
 #include "coopt/segment.hpp"
 #include "coopt/trainer_impl.hpp"
@@ -300,6 +301,7 @@ bool Trainer::run(const std::atomic<bool>* stop) {
     }
   } run_clock(m);
   if (!m.run_files) {
+    if (!t.refit_motion_from.empty()) m.take_motion_model(t.refit_motion_from);
     m.store.create(m.config);
     m.run_files = true;
   }
@@ -318,6 +320,21 @@ bool Trainer::run(const std::atomic<bool>* stop) {
     if (m.state.episode % t.checkpoint_interval == 0 || last) m.checkpoint_in_run();
   }
   return true;
+}
+
+void Trainer::Impl::take_motion_model(const std::string& run_dir) {
+  const CheckpointInfo source = read_checkpoint_info(run_dir);
+  const std::string path = (std::filesystem::path(source.directory) / "motion_actor.pt").string();
+  try {
+    load_learner_file(*state.motion, path);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("trainer.refit_motion_from: " + path + ": its motion model does not fit this run's (" +
+                             config.trainer.motion_algo + ", the motion inputs and network sizes must be the same): " +
+                             e.what());
+  }
+  state.agent.motion->sync_from(*state.motion);
+  std::fprintf(stderr, "refit of the motion model of %s (%d episodes, %s)\n", run_dir.c_str(), source.episodes,
+               source.directory.c_str());
 }
 
 void Trainer::Impl::log_episode(const EpisodeLog& log) {

@@ -109,6 +109,8 @@ struct Trainer::Impl {
   void log_episode(const EpisodeLog& log);
   void evaluate_in_run();
   void checkpoint_in_run();
+  // trainer.refit_motion_from: that run's latest motion model into the learner and the policy.
+  void take_motion_model(const std::string& run_dir);
   // run() with trainer.simulation_threads > 1 (coopt/simulation_threads.cpp).
   bool run_simulation_threads(const std::atomic<bool>* stop);
   void start_threads();

@@ -514,6 +514,35 @@ TEST(Trainer, FixedBaselineAndSacRun) {
   fs::remove_all(b);
 }
 
+// trainer.refit_motion_from: a run that only refits a fresh configuration
+// model on another run's motion model, which it drives exactly as that run
+// does (the same greedy episodes on a forced chain).
+TEST(Trainer, RefitOfAnotherRunsMotionModel) {
+  const std::string a = temp_dir("refit_src"), b = temp_dir("refit_only");
+  run_ci({}, a);
+  const std::vector<std::string> refit = {"trainer.warmup_episodes=0", "trainer.episodes=0",
+                                          "trainer.config_refit_episodes=3", "trainer.refit_motion_from=" + a};
+  const RunResult r = run_ci(refit, b);
+  ASSERT_EQ(r.logs.size(), 3u);
+  EXPECT_FALSE(r.decisions.empty());  // the fresh DQN decides and learns
+  EvalRequest req;
+  req.episodes = 2;
+  req.seed = 77;
+  req.workers = 1;
+  req.forced_modules = 4;
+  const auto from_a = evaluate(load_coopt_config(kCi), a, req);
+  const auto from_b = evaluate(load_coopt_config(kCi, refit), b, req);
+  for (int i = 0; i < 2; ++i) EXPECT_EQ(line_of(from_a[i]), line_of(from_b[i])) << i;
+  // Only a refit may take another run's motion model.
+  EXPECT_THROW(load_coopt_config(kCi, {"trainer.refit_motion_from=" + a}), std::runtime_error);
+  const std::string missing = temp_dir("no_such_run"), bad = temp_dir("refit_bad");
+  EXPECT_THROW(run_ci({"trainer.warmup_episodes=0", "trainer.episodes=0", "trainer.config_refit_episodes=3",
+                       "trainer.refit_motion_from=" + missing},
+                      bad),
+               std::runtime_error);
+  for (const std::string& d : {a, b, missing, bad}) fs::remove_all(d);
+}
+
 // scene_source: classifier runs the ResNet-18 on the last 10 depth frames at
 // every detector decision (here an untrained one: only the plumbing is tested).
 TEST(Trainer, ClassifierSceneSourceRunsTheHierarchy) {
