@@ -205,6 +205,11 @@ void collect(const ExperimentOptions& o, const comorph::report::PaperReference& 
   std::vector<comorph::report::RunDir> runs;
   if (!o.runs.empty()) {
     for (const auto& dir : o.runs) {
+      // A run named twice (runs/x and runs/x/) would count as two seeds.
+      const bool again = std::any_of(run_dirs.begin(), run_dirs.end(), [&](const std::string& d) {
+        return fs::weakly_canonical(d) == fs::weakly_canonical(dir);
+      });
+      if (again) continue;
       try {
         runs.push_back(comorph::report::load_run_dir(dir));
         run_dirs.push_back(dir);

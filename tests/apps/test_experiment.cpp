@@ -168,12 +168,16 @@ TEST(Experiment, CollectsShippedRunsMarkingSingleSeedCells) {
   EXPECT_EQ(table.find("—"), std::string::npos) << table;
   EXPECT_EQ(table.find("Missing"), std::string::npos) << table;
   EXPECT_TRUE(fs::exists(out / "report/report.html"));
-  // A run that is not one is named, the others still make the table.
-  ASSERT_EQ(run_cli("experiment --table 1 --collect --out " + out.string() + " --runs " + out.string() + runs, log), 0)
+  // A run that is not one is named, the others still make the table; a run
+  // named twice is one seed.
+  ASSERT_EQ(run_cli("experiment --table 1 --collect --out " + out.string() + " --runs " + out.string() + runs + " " +
+                        results + "fixed-2/",
+                    log),
+            0)
       << log;
-  EXPECT_NE(read_text(out / "table-1.md").find("Missing, so not in the table: run directory " + out.string()),
-            std::string::npos)
-      << read_text(out / "table-1.md");
+  const std::string again = read_text(out / "table-1.md");
+  EXPECT_NE(again.find("Missing, so not in the table: run directory " + out.string()), std::string::npos) << again;
+  EXPECT_NE(again.find("| 32.3 (1 seed) / 24.2"), std::string::npos) << again;
   fs::remove_all(out);
 }
 

@@ -150,7 +150,8 @@ TEST(ExperimentEngines, SlurmArrayAndGnuParallelGiveTheSameTable) {
   LocalSlurm slurm(root + "/cluster");
   ASSERT_TRUE(slurm.started) << slurm.start_log;
   const auto start = Clock::now();
-  ASSERT_EQ(run_shell("sbatch --wait --array=0-11%2 " + root + "/table1.sbatch", log), 0) << log;
+  // Bounded: a cluster that never runs the tasks fails the test instead of hanging it.
+  ASSERT_EQ(run_shell("timeout 600 sbatch --wait --array=0-11%2 " + root + "/table1.sbatch", log), 0) << log;
   const double slurm_s = std::chrono::duration<double>(Clock::now() - start).count();
   std::printf("Slurm: 12 tasks, at most 2 at once: %.0f s\n", slurm_s);
   for (const auto& column : kColumns)
