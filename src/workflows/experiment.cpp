@@ -221,13 +221,16 @@ void collect(const ExperimentOptions& o, const comorph::report::PaperReference& 
     for (const auto& table : paper.tables)
       for (const auto& run : runs_of_table(o, paper, table.id)) {
         if (std::find(run_dirs.begin(), run_dirs.end(), run.dir) != run_dirs.end()) continue;
-        const std::string why = missing_reason(run);
+        std::string why = missing_reason(run);
         if (why.empty()) {
-          runs.push_back(comorph::report::load_run_dir(run.dir));
-          run_dirs.push_back(run.dir);
-        } else if (table.id == o.table) {
-          missing.push_back(run.dir + ": " + why);
+          try {
+            runs.push_back(comorph::report::load_run_dir(run.dir));
+            run_dirs.push_back(run.dir);
+          } catch (const std::exception& e) {
+            why = e.what();
+          }
         }
+        if (!why.empty() && table.id == o.table) missing.push_back(run.dir + ": " + why);
       }
   }
   std::string table_md;
