@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -37,10 +38,22 @@ bool matches(const RunDir& run, const RunMatch& match) {
          run.evals.count(match.eval_scenario);
 }
 
-const RunDir* find_run(const std::vector<RunDir>& runs, const RunMatch& match) {
-  for (const auto& r : runs)
-    if (matches(r, match)) return &r;
-  return nullptr;
+// One figure over a column's runs: "mean [min, max]" over the runs that have
+// it, "value (1 seed)" for a single run; runs without it (no successful
+// episode has no time) are counted as "(k of n seeds)".
+std::string over_seeds(const std::vector<double>& values, int decimals) {
+  std::vector<double> finite;
+  for (double v : values)
+    if (std::isfinite(v)) finite.push_back(v);
+  if (finite.empty()) return "n/a";
+  const auto [lo, hi] = std::minmax_element(finite.begin(), finite.end());
+  double mean = 0;
+  for (double v : finite) mean += v / static_cast<double>(finite.size());
+  std::string s = finite.size() == 1 ? fmt::format("{} (1 seed)", num(mean, decimals))
+                                     : fmt::format("{} [{}, {}]", num(mean, decimals), num(*lo, decimals), num(*hi, decimals));
+  if (finite.size() < values.size() && values.size() > 1)
+    s += fmt::format(" ({} of {} seeds)", finite.size(), values.size());
+  return s;
 }
 
 // The most frequent configuration sequence and its share of the episodes.
@@ -127,35 +140,79 @@ std::string describe(const RunInfo& info) {
 
 }  // namespace
 
+std::vector<const RunDir*> column_runs(const PaperColumn& column, const std::vector<RunDir>& runs) {
+  std::vector<const RunDir*> found;
+  for (const auto& r : runs)
+    if (matches(r, column.match) && (found.empty() || r.config_key == found.front()->config_key)) found.push_back(&r);
+  return found;
+}
+
+std::string comparison_table_legend() {
+  return "Every cell reads \"ours / paper\". Ours is the mean over the training seeds of the column's run "
+         "configuration with [lowest, highest] over the seeds, or the value of a single seed, marked \"(1 seed)\"; "
+         "a dash marks a column with no run.";
+}
+
 ReportBlock comparison_table(const PaperTable& paper, const std::vector<RunDir>& runs) {
   std::vector<std::string> header = {""};
-  std::vector<const EvalSummary*> ours;
+  std::vector<std::vector<const EvalSummary*>> ours;  // per column: its runs' evaluations
+  std::vector<std::vector<const RunDir*>> seeds;
   for (const auto& col : paper.columns) {
-    const RunDir* run = find_run(runs, col.match);
-    header.push_back(run ? fmt::format("{} [{}]", col.label, run->info.name) : col.label);
-    ours.push_back(run ? &run->evals.at(col.match.eval_scenario) : nullptr);
+    const auto found = column_runs(col, runs);
+    if (found.empty()) header.push_back(col.label);
+    else if (found.size() == 1) header.push_back(fmt::format("{} [{}]", col.label, found.front()->info.name));
+    else header.push_back(fmt::format("{} [{} runs]", col.label, found.size()));
+    std::vector<const EvalSummary*> evals;
+    for (const RunDir* r : found) evals.push_back(&r->evals.at(col.match.eval_scenario));
+    ours.push_back(evals);
+    seeds.push_back(found);
   }
   std::vector<std::vector<std::string>> rows;
-  auto row = [&](const std::string& name, auto our_value, auto paper_value) {
+  auto text_row = [&](const std::string& name, auto our_text, auto paper_text) {
     std::vector<std::string> r = {name};
-    for (size_t c = 0; c < paper.columns.size(); ++c) {
-      const std::string o = ours[c] ? our_value(*ours[c]) : "—";
-      r.push_back(fmt::format("{} / {}", o, paper_value(paper.columns[c])));
-    }
+    for (size_t c = 0; c < paper.columns.size(); ++c)
+      r.push_back(fmt::format("{} / {}", c < ours.size() && !ours[c].empty() ? our_text(c) : "—",
+                              paper_text(paper.columns[c])));
     rows.push_back(std::move(r));
   };
-  row("Time (s)", [](const EvalSummary& m) { return num(m.time_s, 1); },
-      [](const PaperColumn& p) { return paper_num(p.time_s); });
-  row("Battery (J)", [](const EvalSummary& m) { return num(m.energy_J, 0); },
-      [](const PaperColumn& p) { return paper_num(p.energy_J); });
+  // A figure of our evaluations (value_of) over the seeds, beside the paper's (paper_value).
+  auto row = [&](const std::string& name, auto value_of, int decimals, auto paper_value) {
+    text_row(
+        name,
+        [&](size_t c) {
+          std::vector<double> values;
+          for (const EvalSummary* m : ours[c]) values.push_back(value_of(*m));
+          return over_seeds(values, decimals);
+        },
+        [&](const PaperColumn& p) { return paper_num(paper_value(p)); });
+  };
+  row("Time (s)", [](const EvalSummary& m) { return m.time_s; }, 1, [](const PaperColumn& p) { return p.time_s; });
+  row("Battery (J)", [](const EvalSummary& m) { return m.energy_J; }, 0,
+      [](const PaperColumn& p) { return p.energy_J; });
   for (const std::string key : {"0.04", "0.06", "0.08", "avg"}) {
     const std::string name = key == "avg" ? "Success avg (%)" : fmt::format("Success {} m (%)", key);
-    row(name, [key](const EvalSummary& m) { return percent(lookup(m.success_rate, key)); },
-        [key](const PaperColumn& p) { return paper_num(lookup(p.success_percent, key)); });
+    row(name, [key](const EvalSummary& m) { return 100.0 * lookup(m.success_rate, key); }, 1,
+        [key](const PaperColumn& p) { return lookup(p.success_percent, key); });
   }
-  row("F(H)", [](const EvalSummary& m) { return num(m.F, 3); }, [](const PaperColumn& p) { return paper_num(p.F); });
-  row("Episodes", [](const EvalSummary& m) { return std::to_string(m.episodes); },
-      [](const PaperColumn&) { return std::string("n/a"); });
+  row("F(H)", [](const EvalSummary& m) { return m.F; }, 3, [](const PaperColumn& p) { return p.F; });
+  auto not_given = [](const PaperColumn&) { return std::string("n/a"); };
+  text_row(
+      "Episodes",
+      [&](size_t c) {
+        std::vector<std::string> counts;
+        for (const EvalSummary* m : ours[c]) counts.push_back(std::to_string(m->episodes));
+        const bool same = std::all_of(counts.begin(), counts.end(), [&](const auto& n) { return n == counts.front(); });
+        return same ? counts.front() + (counts.size() > 1 ? " each" : "") : fmt::format("{}", fmt::join(counts, ", "));
+      },
+      not_given);
+  text_row(
+      "Training seeds",
+      [&](size_t c) {
+        std::vector<std::string> list;
+        for (const RunDir* r : seeds[c]) list.push_back(r->config_key.empty() ? "?" : std::to_string(r->seed));
+        return fmt::format("{}", fmt::join(list, ", "));
+      },
+      not_given);
   return table(std::move(header), std::move(rows));
 }
 
@@ -229,16 +286,18 @@ ReportResult write_report(const std::vector<std::string>& run_dirs, const Report
   std::vector<ReportBlock> doc;
   doc.push_back(heading(1, "comorph report"));
   doc.push_back(paragraph(fmt::format(
-      "Runs: {}. Every table cell reads \"ours / paper\" (the paper: {}; numbers from {}). "
+      "Runs: {}. {} The paper: {}; numbers from {}. "
       "Time and Battery average the successful evaluation episodes only; success is counted per stair "
-      "height and averaged over the heights. \"—\" marks a column with no matching run.",
-      run_dirs.size(), paper.source, ref_path)));
+      "height and averaged over the heights.",
+      run_dirs.size(), comparison_table_legend(), paper.source, ref_path)));
   if (!paper.protocol.empty()) doc.push_back(paragraph("Paper protocol: " + paper.protocol));
 
   for (const auto& t : paper.tables) {
     doc.push_back(heading(2, t.title));
     doc.push_back(comparison_table(t, runs));
   }
+  if (!options.missing.empty())
+    doc.push_back(paragraph(fmt::format("Missing, so not in the tables: {}.", fmt::join(options.missing, "; "))));
   for (const auto& note : paper.notes) doc.push_back(paragraph("Paper: " + note));
 
   // Training curves, all runs in one figure as in Fig. 9.

@@ -15,6 +15,7 @@ struct ReportOptions {
   std::string reference_path;       // paper tables YAML; "" = default_paper_reference_path()
   int curve_window = 100;           // episodes in the moving averages of the training curves
   bool require_plots = true;        // false: without gnuplot, write the report without curves (and say so)
+  std::vector<std::string> missing; // runs an experiment lacks, one line each, listed under the tables
 };
 
 struct ReportResult {
@@ -36,9 +37,18 @@ struct ReportBlock {
 std::string render_markdown(const std::vector<ReportBlock>& blocks);
 std::string render_html(const std::vector<ReportBlock>& blocks, const std::string& title);
 
-// The paper table with "ours / paper" in every cell; a column's run is the
-// first of `runs` that matches it (RunMatch).
+// The runs a paper column shows: those of `runs` that match it (RunMatch)
+// and have the configuration of the first match (RunDir::config_key), i.e.
+// that configuration's training seeds. Empty when none matches.
+std::vector<const RunDir*> column_runs(const PaperColumn& column, const std::vector<RunDir>& runs);
+
+// The paper table with "ours / paper" in every cell. Ours is the mean over
+// the column's runs (column_runs) with [min, max] over them, or the one run's
+// value marked "(1 seed)"; a row names the training seeds.
 ReportBlock comparison_table(const PaperTable& table, const std::vector<RunDir>& runs);
+
+// What every comparison table's cell means, as a paragraph.
+std::string comparison_table_legend();
 
 // Loads every run directory (throws naming what is missing), writes the report.
 ReportResult write_report(const std::vector<std::string>& run_dirs, const ReportOptions& options);

@@ -94,6 +94,20 @@ RunDir load_run_dir(const std::string& path) {
     const std::string stem = e.stem().string();  // eval-<scenario>
     run.evals[stem.substr(5)] = read_metrics_json(e.string());
   }
+  const fs::path config = dir / "config.yaml";
+  if (fs::is_regular_file(config)) {
+    YAML::Node root = load_yaml_file(config.string());
+    YAML::Node trainer = root.IsMap() ? root["trainer"] : YAML::Node();
+    if (trainer.IsMap() && trainer["seed"]) {
+      try {
+        run.seed = trainer["seed"].as<int>();
+      } catch (const YAML::Exception&) {
+        throw std::runtime_error(fmt::format("{}: trainer.seed is not an integer", config.string()));
+      }
+      trainer.remove("seed");
+    }
+    run.config_key = YAML::Dump(root);
+  }
   return run;
 }
 

@@ -2,6 +2,7 @@
 //   run.yaml             what the run is (RunInfo below)
 //   episodes.csv         one row per training episode (episode_record.hpp)
 //   eval-<scenario>.json one evaluation summary per test scenario (metrics.hpp)
+//   config.yaml          optional here: the run's configuration (its training seed)
 #pragma once
 
 #include <map>
@@ -37,6 +38,12 @@ struct RunDir {
   RunInfo info;
   std::map<std::string, EvalSummary> evals;  // test scenario -> its eval-<scenario>.json
   std::string episodes_csv;              // path of episodes.csv
+  // From config.yaml when the run has one: its trainer.seed (0: no
+  // config.yaml), and the configuration without that seed, so that the runs
+  // of one configuration trained with different seeds can be told from the
+  // runs of another ("" without config.yaml).
+  int seed = 0;
+  std::string config_key;
 };
 
 RunInfo read_run_info(const std::string& run_yaml_path, const std::string& default_name);

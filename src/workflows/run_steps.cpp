@@ -43,17 +43,24 @@ const comorph::task::ObjectiveWeights& f_weights(const CooptConfig& c) { return 
 
 }  // namespace
 
+namespace {
+// What a run directory may hold before its training starts.
+bool kept_before_training(const fs::path& entry) {
+  return entry.filename() == RunLock::kFileName || entry.filename() == kJobLogFile;
+}
+}  // namespace
+
 bool is_empty_run_dir(const std::string& dir) {
   if (!fs::exists(dir)) return true;
   if (!fs::is_directory(dir)) return false;
   for (const auto& entry : fs::directory_iterator(dir))
-    if (entry.path().filename() != RunLock::kFileName) return false;
+    if (!kept_before_training(entry.path())) return false;
   return true;
 }
 
 void clear_run_dir(const std::string& dir) {
   for (const auto& entry : fs::directory_iterator(dir))
-    if (entry.path().filename() != RunLock::kFileName) fs::remove_all(entry.path());
+    if (!kept_before_training(entry.path())) fs::remove_all(entry.path());
 }
 
 bool train_run(const std::string& config_path, const std::vector<std::string>& sets, const std::string& out,

@@ -21,9 +21,13 @@ namespace comorph::workflows {
 bool train_run(const std::string& config_path, const std::vector<std::string>& sets, const std::string& out,
                const std::string& resume, bool locked_by_caller = false);
 
-// True when `dir` is missing or holds nothing but a run lock file.
+// The log a job of `comorph experiment --jobs/--slurm` appends to in its run
+// directory: like the lock file, there before the training starts.
+inline constexpr const char* kJobLogFile = "job.log";
+
+// True when `dir` is missing or holds nothing but a run lock file and a job log.
 bool is_empty_run_dir(const std::string& dir);
-// Removes everything in `dir` but the lock file (that a caller may hold).
+// Removes everything in `dir` but the lock file (that a caller may hold) and the job log.
 void clear_run_dir(const std::string& dir);
 
 // Greedy evaluation of a trained run on the paper's protocol: writes

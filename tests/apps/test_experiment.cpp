@@ -101,7 +101,84 @@ TEST(Experiment, BadTableOrColumnIsNamedBeforeAnyTraining) {
   EXPECT_NE(log.find("fixed-4"), std::string::npos) << log;  // the message lists the columns
   EXPECT_NE(run_cli("experiment --table 1 --set trainer.epsiodes=2 --config " + kCi + " --out " + out.string(), log), 0);
   EXPECT_NE(log.find("trainer.epsiodes"), std::string::npos) << log;
+  for (const char* seeds : {"2-x", "3-1", "0", "1,1-2", ""}) {
+    EXPECT_NE(run_cli("experiment --table 1 --seeds '" + std::string(seeds) + "' --config " + kCi + " --out " +
+                          out.string(),
+                      log),
+              0);
+    EXPECT_NE(log.find("--seeds"), std::string::npos) << seeds << ": " << log;
+  }
+  EXPECT_NE(run_cli("experiment --table 1 --out " + out.string(), log), 0);
+  EXPECT_NE(log.find("give --config"), std::string::npos) << log;
   EXPECT_FALSE(fs::exists(out));
+}
+
+// --seeds: a run directory per column and seed, trained with that seed; the
+// table shows the column's mean [min, max] over them and names the runs
+// still missing; --collect makes the same table from what exists.
+TEST(Experiment, SeedsAreRunsOfTheirOwnAndTheTableNamesWhatIsMissing) {
+  const fs::path out = fs::temp_directory_path() / ("comorph_experiment_seeds_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  std::string log;
+  ASSERT_EQ(run_cli("experiment --table 1 --only fixed-2 --seeds 1,3 --config " + kCi +
+                        " --set trainer.eval_interval=0 --eval-episodes 3 --out " + out.string(),
+                    log),
+            0)
+      << log;
+  for (int seed : {1, 3}) {
+    const fs::path run = out / ("fixed-2-seed-" + std::to_string(seed));
+    EXPECT_TRUE(fs::exists(run / "eval-default.json")) << run;
+    EXPECT_TRUE(fs::exists(run / "finished")) << run;
+    EXPECT_NE(read_text(run / "config.yaml").find("  seed: " + std::to_string(seed) + "\n"), std::string::npos);
+  }
+  EXPECT_NE(read_text(out / "fixed-2-seed-1/episodes.csv"), read_text(out / "fixed-2-seed-3/episodes.csv"));
+  const std::string table = read_text(out / "table-1.md");
+  for (const char* part : {"Fixed 2 [2 runs]", "| 1, 3 / n/a", "Missing, so not in the table: ",
+                           "fixed-4-seed-3: not started", "hier-td3-seed-1: not started"})
+    EXPECT_NE(table.find(part), std::string::npos) << part << " not in\n" << table;
+  EXPECT_EQ(table.find("fixed-2-seed-1:"), std::string::npos) << table;
+  EXPECT_NE(read_text(out / "report/report.md").find("fixed-4-seed-3: not started"), std::string::npos);
+
+  // A run stopped before its end is named with how far it got.
+  fs::remove(out / "fixed-2-seed-3/eval-default.json");
+  ASSERT_EQ(run_cli("experiment --table 1 --seeds 1,3 --out " + out.string() + " --collect", log), 0) << log;
+  const std::string collected = read_text(out / "table-1.md");
+  EXPECT_NE(collected.find("Fixed 2 [fixed-2-seed-1]"), std::string::npos) << collected;
+  EXPECT_NE(collected.find("(1 seed) / 24.2"), std::string::npos) << collected;
+  EXPECT_NE(collected.find("fixed-2-seed-3: trained, not evaluated on default"), std::string::npos) << collected;
+  fs::remove_all(out);
+}
+
+// The published tables over runs that exist (results/, one seed each): every
+// Table I column from its shipped run, each cell marked as one seed's.
+TEST(Experiment, CollectsShippedRunsMarkingSingleSeedCells) {
+  const fs::path out = fs::temp_directory_path() / ("comorph_experiment_collect_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const std::string results = std::string(COMORPH_SOURCE_DIR) + "/results/";
+  std::string runs;
+  for (const char* r : {"standard-hier-td3", "fixed-2", "fixed-4", "fixed-6", "fixed-8", "fixed-10"})
+    runs += " " + results + r;
+  std::string log;
+  ASSERT_EQ(run_cli("experiment --table 1 --collect --out " + out.string() + " --runs" + runs, log), 0) << log;
+  const std::string table = read_text(out / "table-1.md");
+  // results/fixed-2: 97 % at 0.04 m, 32.3 % on average (its eval-default.json).
+  for (const char* part : {"Ours (hierarchical) [hier-td3]", "Fixed 2 [fixed-2]", "| 97.0 (1 seed) / 72.5",
+                           "| 32.3 (1 seed) / 24.2", "| 1 / n/a"})
+    EXPECT_NE(table.find(part), std::string::npos) << part << " not in\n" << table;
+  EXPECT_EQ(table.find("—"), std::string::npos) << table;
+  EXPECT_EQ(table.find("Missing"), std::string::npos) << table;
+  EXPECT_TRUE(fs::exists(out / "report/report.html"));
+  // A run that is not one is named, the others still make the table; a run
+  // named twice is one seed.
+  ASSERT_EQ(run_cli("experiment --table 1 --collect --out " + out.string() + " --runs " + out.string() + runs + " " +
+                        results + "fixed-2/",
+                    log),
+            0)
+      << log;
+  const std::string again = read_text(out / "table-1.md");
+  EXPECT_NE(again.find("Missing, so not in the table: run directory " + out.string()), std::string::npos) << again;
+  EXPECT_NE(again.find("| 32.3 (1 seed) / 24.2"), std::string::npos) << again;
+  fs::remove_all(out);
 }
 
 // The matrix is the data of configs/reference/paper-tables.yaml: a column

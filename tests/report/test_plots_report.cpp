@@ -151,18 +151,18 @@ TEST(Report, TablesHoldThePapersNumbersAndOurs) {
   const std::string html = slurp(result.html_path);
 
   // Table I, hierarchical column: ours beside the paper's 43.1 s, 3090 J, 89.3 %, F 1.136.
-  EXPECT_NE(md.find(fmt::format("| {:.1f} / 43.1 |", runs.hier_eval.time_s)), std::string::npos) << md;
-  EXPECT_NE(md.find(fmt::format("| {:.0f} / 3090 |", runs.hier_eval.energy_J)), std::string::npos) << md;
-  EXPECT_NE(md.find(fmt::format("| {:.1f} / 89.3 |", 100 * runs.hier_eval.success_rate.at("avg"))),
+  EXPECT_NE(md.find(fmt::format("| {:.1f} (1 seed) / 43.1 |", runs.hier_eval.time_s)), std::string::npos) << md;
+  EXPECT_NE(md.find(fmt::format("| {:.0f} (1 seed) / 3090 |", runs.hier_eval.energy_J)), std::string::npos) << md;
+  EXPECT_NE(md.find(fmt::format("| {:.1f} (1 seed) / 89.3 |", 100 * runs.hier_eval.success_rate.at("avg"))),
             std::string::npos) << md;
-  EXPECT_NE(md.find(fmt::format("| {:.3f} / 1.136 |", runs.hier_eval.F)), std::string::npos) << md;
+  EXPECT_NE(md.find(fmt::format("| {:.3f} (1 seed) / 1.136 |", runs.hier_eval.F)), std::string::npos) << md;
   // Fixed 4: ours beside 42.7 s and 78.5 % at 0.04 m; fixed 2 has no run.
-  EXPECT_NE(md.find(fmt::format("| {:.1f} / 42.7 |", runs.fixed4_eval.time_s)), std::string::npos) << md;
-  EXPECT_NE(md.find(fmt::format("| {:.1f} / 78.5 |", 100 * runs.fixed4_eval.success_rate.at("0.04"))),
+  EXPECT_NE(md.find(fmt::format("| {:.1f} (1 seed) / 42.7 |", runs.fixed4_eval.time_s)), std::string::npos) << md;
+  EXPECT_NE(md.find(fmt::format("| {:.1f} (1 seed) / 78.5 |", 100 * runs.fixed4_eval.success_rate.at("0.04"))),
             std::string::npos) << md;
   EXPECT_NE(md.find("| — / 56.2 |"), std::string::npos) << md;
   // Table II: 7 obstacles from eval-obstacles7.json; SAC has no run.
-  EXPECT_NE(md.find(fmt::format("| {:.1f} / 50.2 |", runs.hier_eval7.time_s)), std::string::npos) << md;
+  EXPECT_NE(md.find(fmt::format("| {:.1f} (1 seed) / 50.2 |", runs.hier_eval7.time_s)), std::string::npos) << md;
   EXPECT_NE(md.find("| — / 57.6 |"), std::string::npos) << md;
   // The mixed column wants a run trained on the mixed scene (match.train): the default-trained one is not it.
   EXPECT_NE(md.find("| — / 25 |"), std::string::npos) << md;
@@ -172,13 +172,49 @@ TEST(Report, TablesHoldThePapersNumbersAndOurs) {
   EXPECT_NE(md.find("| default | 0.06 |"), std::string::npos) << md;
   EXPECT_NE(md.find("| 4->2 |"), std::string::npos) << md;
   EXPECT_NE(html.find("<table>"), std::string::npos);
-  EXPECT_NE(html.find(fmt::format("<td>{:.1f} / 43.1</td>", runs.hier_eval.time_s)), std::string::npos);
+  EXPECT_NE(html.find(fmt::format("<td>{:.1f} (1 seed) / 43.1</td>", runs.hier_eval.time_s)), std::string::npos);
 
   if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed: no training curves to check";
   ASSERT_EQ(result.images.size(), 1u);
   expect_png(result.images[0]);
   EXPECT_NE(md.find("![Score per episode"), std::string::npos);
   EXPECT_NE(html.find("<img src=\"training-curves.png\""), std::string::npos);
+}
+
+// Runs of one configuration trained with different seeds (config.yaml but
+// trainer.seed the same) are one column: each figure their mean with
+// [min, max]; a run of another configuration matching the same column is not
+// averaged in.
+TEST(Report, ColumnAveragesTheSeedsOfOneConfiguration) {
+  TinyRuns runs;
+  auto config = [](int seed, int episodes) {
+    return fmt::format("trainer:\n  mode: fixed\n  seed: {}\n  episodes: {}\n", seed, episodes);
+  };
+  std::ofstream(runs.fixed4 / "config.yaml") << config(1, 250);
+  const fs::path seed2 = runs.root / "fixed-4-seed-2", other = runs.root / "fixed-4-other";
+  for (const auto& [dir, text] : {std::pair{seed2, config(2, 250)}, std::pair{other, config(3, 999)}}) {
+    fs::create_directories(dir);
+    fs::copy_file(runs.fixed4 / "run.yaml", dir / "run.yaml");
+    fs::copy_file(runs.fixed4 / "episodes.csv", dir / "episodes.csv");
+    std::ofstream(dir / "config.yaml") << text;
+  }
+  const EvalSummary second = summarize(fake_episodes(60, 4, 6));
+  write_metrics_json((seed2 / "eval-default.json").string(), second);
+  write_metrics_json((other / "eval-default.json").string(), summarize(fake_episodes(60, 4, 7)));
+  std::vector<RunDir> loaded;
+  for (const auto& d : {runs.fixed4, other, seed2}) loaded.push_back(load_run_dir(d.string()));
+  EXPECT_EQ(loaded[2].seed, 2);
+
+  const PaperReference paper = load_paper_reference(default_paper_reference_path());
+  const std::string md = render_markdown({comparison_table(paper.tables.at(0), loaded)});
+  const double a = 100 * runs.fixed4_eval.success_rate.at("avg"), b = 100 * second.success_rate.at("avg");
+  ASSERT_NE(a, b);
+  EXPECT_NE(md.find(fmt::format("| {:.1f} [{:.1f}, {:.1f}] / 70.6 |", (a + b) / 2, std::min(a, b), std::max(a, b))),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("Fixed 4 [2 runs]"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 60 each / n/a |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 1, 2 / n/a |"), std::string::npos) << md;  // the seeds; not the other configuration's 3
 }
 
 // A keyframe strip left by `comorph render` in a run directory is copied and shown.
