@@ -4,7 +4,8 @@
 # classifier driving the switches (300 + 4000 episodes + 1000 of DQN refit;
 # about 2 hours for seed 1 on 2 cores, docs/results.md), then evaluate it greedily on
 # 300 episodes (100 per stair height) of the config's eval seeds.
-# Usage: scripts/run-standard.sh [build_dir] [run_dir] [extra --set ...]
+# Usage: [PRESET=configs/rl-only.yaml] scripts/run-standard.sh [build_dir] [run_dir] [extra --set ...]
+# PRESET: another preset of the standard budget (default configs/standard.yaml).
 # Interrupted? Run it again: it resumes the run from its last checkpoint.
 set -euo pipefail
 build_dir=${1:-build}
@@ -18,5 +19,5 @@ source scripts/run-lib.sh
 prepare_classifier "$comorph" "$classifier"
 sets=()
 for s in "$@"; do sets+=(--set "$s"); done
-train_or_resume "$comorph" "$run" configs/standard.yaml "$classifier" "${sets[@]}"
+train_or_resume "$comorph" "$run" "${PRESET:-configs/standard.yaml}" "$classifier" "${sets[@]}"
 "$comorph" eval --run "$run" --scenario default --episodes 300
