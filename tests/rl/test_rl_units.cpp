@@ -613,12 +613,8 @@ TEST(NStepReturns, OneStepPassesTransitionsThrough) {
   EXPECT_THROW(rl::NStepReturns(0, 0.99), std::invalid_argument);
 }
 
-// Behaviour cloning: every transition ends with reward 1 whatever the action,
-// so the critic learns a flat Q and gives the actor no direction; only the BC term on the demonstrated transitions can move it to
-// the demonstrated action (0.7 where x > 0, -0.4 where x < 0). Without it the
-// actor stays where the initialisation put it. Non-demonstrated transitions
-// with other actions must not pull it.
-double bc_error_after_training(double bc_weight) {
+// A small TD3 that updates its actor at every update, from the first transition.
+rl::Td3Config small_td3() {
   rl::Td3Config c;
   c.hidden_sizes = {32, 32};
   c.batch_size = 64;
@@ -627,6 +623,16 @@ double bc_error_after_training(double bc_weight) {
   c.random_action_steps = 0;
   c.policy_delay = 1;
   c.actor_learning_rate = 3e-3;
+  return c;
+}
+
+// Behaviour cloning: every transition ends with reward 1 whatever the action,
+// so the critic learns a flat Q and gives the actor no direction; only the BC term on the demonstrated transitions can move it to
+// the demonstrated action (0.7 where x > 0, -0.4 where x < 0). Without it the
+// actor stays where the initialisation put it. Non-demonstrated transitions
+// with other actions must not pull it.
+double bc_error_after_training(double bc_weight) {
+  rl::Td3Config c = small_td3();
   c.bc_weight = bc_weight;
   rl::Td3 td3({0, 0, 0, 1}, 1, c, 3);
   rl::Action a;
@@ -660,14 +666,7 @@ TEST(Td3, BehaviourCloningPullsTheActorToTheDemonstratedActions) {
 // action the reward prefers (one-step episodes, reward -(a - 0.6)^2).
 TEST(Td3, ActorQWeightZeroLeavesTheActorToImitationAlone) {
   for (double q_weight : {1.0, 0.0}) {
-    rl::Td3Config c;
-    c.hidden_sizes = {32, 32};
-    c.batch_size = 64;
-    c.buffer_size = 1000;
-    c.learning_starts = 0;
-    c.random_action_steps = 0;
-    c.policy_delay = 1;
-    c.actor_learning_rate = 3e-3;
+    rl::Td3Config c = small_td3();
     c.bc_weight = q_weight == 0 ? 1.0 : 0.0;  // with 0: the imitation term alone, but nothing carries a target
     c.actor_q_weight = q_weight;
     rl::Td3 td3({0, 0, 0, 1}, 1, c, 3);
