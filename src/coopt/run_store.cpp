@@ -36,8 +36,7 @@ void load_file(Model& model, const std::string& path) {
   }
 }
 
-// A learner's replay from its checkpoint's segments (rl/replay_segments.hpp;
-// an older checkpoint's learner file held it, and then there is no index).
+// A learner's replay from its checkpoint's segments (rl/replay_segments.hpp).
 // Every transition the learner counts must be back: a missing index would
 // otherwise resume with an empty buffer.
 rl::ReplaySegments load_replay(rl::Learner& learner, const std::string& name, const std::string& dir) {
@@ -150,9 +149,6 @@ CheckpointInfo read_checkpoint_info(const std::string& run_dir) {
     std::string problem;
     if (!fs::exists(fs::path(candidate) / "trainer.yaml")) {
       problem = candidate + ": incomplete (no trainer.yaml)";
-    } else if (!fs::exists(fs::path(candidate) / kChecksumFile)) {
-      std::fprintf(stderr, "comorph: warning: %s has no %s (written before checkpoints had checksums): not verified\n",
-                   candidate.c_str(), kChecksumFile);
     } else {
       problem = verify_checksums(candidate);
     }

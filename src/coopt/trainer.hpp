@@ -161,7 +161,6 @@ class Trainer {
   bool run(const std::atomic<bool>* stop = nullptr);
 
   int episodes_done() const;
-  int evaluations_done() const;
   std::int64_t env_steps() const;
   double wall_s() const;  // training wall time including resumed parts
   TrainerTiming timing() const;

@@ -142,8 +142,7 @@ TEST(Checksum, FindsAFlippedByteATruncationAndAMissingFile) {
   const std::string dir = test_support::fresh_temp_dir("checksum");
   write_file_atomic(dir + "/a.pt", std::string(10000, 'a'));
   write_file_atomic(dir + "/b.yaml", "episodes: 4\n");
-  EXPECT_NE(verify_checksums(dir), "");  // no checksum file yet
-  EXPECT_EQ(verify_checksums(dir, true), "");
+  EXPECT_NE(verify_checksums(dir).find("checksums.txt: missing"), std::string::npos);  // no checksum file yet
   write_checksums(dir, {"a.pt", "b.yaml"});
   EXPECT_EQ(verify_checksums(dir), "");
   {
