@@ -272,14 +272,11 @@ std::string render_html(const std::vector<ReportBlock>& blocks, const std::strin
   return out + "</body>\n</html>\n";
 }
 
-ReportResult write_report(const std::vector<std::string>& run_dirs, const ReportOptions& options) {
-  if (run_dirs.empty()) throw std::invalid_argument("report: no run directories given");
-  if (options.out_dir.empty()) throw std::invalid_argument("report: no output directory given");
-  const std::string ref_path = options.reference_path.empty() ? default_paper_reference_path() : options.reference_path;
-  const PaperReference paper = load_paper_reference(ref_path);
-  std::vector<RunDir> runs;
-  for (const auto& d : run_dirs) runs.push_back(load_run_dir(d));
-  fs::create_directories(options.out_dir);
+namespace {
+
+ReportResult write_report_files(const std::vector<RunDir>& runs, const std::vector<CurveSeries>& series,
+                                const PaperReference& paper, const std::string& ref_path,
+                                const ReportOptions& options) {
   const fs::path out(options.out_dir);
   ReportResult result;
 
@@ -289,7 +286,7 @@ ReportResult write_report(const std::vector<std::string>& run_dirs, const Report
       "Runs: {}. {} The paper: {}; numbers from {}. "
       "Time and Battery average the successful evaluation episodes only; success is counted per stair "
       "height and averaged over the heights.",
-      run_dirs.size(), comparison_table_legend(), paper.source, ref_path)));
+      runs.size(), comparison_table_legend(), paper.source, ref_path)));
   if (!paper.protocol.empty()) doc.push_back(paragraph("Paper protocol: " + paper.protocol));
 
   for (const auto& t : paper.tables) {
@@ -302,8 +299,6 @@ ReportResult write_report(const std::vector<std::string>& run_dirs, const Report
 
   // Training curves, all runs in one figure as in Fig. 9.
   doc.push_back(heading(2, "Training curves"));
-  std::vector<CurveSeries> series;
-  for (const auto& r : runs) series.push_back({r.info.name, read_episodes_csv(r.episodes_csv)});
   const bool have_gnuplot = !find_executable("gnuplot").empty();
   if (have_gnuplot || options.require_plots) {
     CurveOptions curve;
@@ -376,6 +371,29 @@ ReportResult write_report(const std::vector<std::string>& run_dirs, const Report
   write_file_atomic(result.html_path, render_html(doc, "comorph report"));
   spdlog::info("report: {} and {} ({} images)", result.markdown_path, result.html_path, result.images.size());
   return result;
+}
+
+}  // namespace
+
+ReportResult write_report(const std::vector<std::string>& run_dirs, const ReportOptions& options) {
+  if (run_dirs.empty()) throw std::invalid_argument("report: no run directories given");
+  if (options.out_dir.empty()) throw std::invalid_argument("report: no output directory given");
+  const std::string ref_path = options.reference_path.empty() ? default_paper_reference_path() : options.reference_path;
+  const PaperReference paper = load_paper_reference(ref_path);
+  // Everything is read before anything is written: a damaged input leaves no output behind.
+  std::vector<RunDir> runs;
+  for (const auto& d : run_dirs) runs.push_back(load_run_dir(d));
+  std::vector<CurveSeries> series;
+  for (const auto& r : runs) series.push_back({r.info.name, read_episodes_csv(r.episodes_csv)});
+  const bool created = !fs::exists(options.out_dir);
+  fs::create_directories(options.out_dir);
+  try {
+    return write_report_files(runs, series, paper, ref_path, options);
+  } catch (...) {
+    std::error_code ignored;
+    if (created) fs::remove_all(options.out_dir, ignored);
+    throw;
+  }
 }
 
 }  // namespace comorph::report
