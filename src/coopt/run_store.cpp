@@ -171,8 +171,7 @@ CheckpointInfo read_checkpoint_info(const std::string& run_dir) {
     info.env_steps = n["env_steps"].as<std::int64_t>();
     info.wall_s = n["wall_s"].as<double>();
     info.config_text = n["config"].as<std::string>();
-    if (n["env_files"]) info.env_text = n["env_files"].as<std::string>();
-    info.has_env_text = static_cast<bool>(n["env_files"]);
+    info.env_text = n["env_files"].as<std::string>();
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(path + ": unreadable checkpoint: " + e.msg);
   }
@@ -196,16 +195,19 @@ void check_checkpoint_counts(const CheckpointInfo& info, const CooptConfig& conf
 }
 
 void check_same_run(const CheckpointInfo& info, const CooptConfig& config, const std::string& run_dir) {
-  if (info.config_text != config.text)
-    throw std::runtime_error(run_dir + ": the checkpoint was written by another configuration (" +
-                             first_difference(config.text, info.config_text) + ")");
-  if (!info.has_env_text)
-    std::fprintf(stderr, "comorph: warning: %s predates simulator-config checks: configs/sim not compared\n",
-                 info.directory.c_str());
-  else if (info.env_text != config.env_text)
+  if (info.env_text != config.env_text)
     throw std::runtime_error(run_dir + ": the simulator config (" + config.env_dir +
                              ") changed since the checkpoint was written (" +
                              first_difference(config.env_text, info.env_text) + ")");
+  // Checkpoints hold the resolved config; those written before configs were
+  // resolved hold the merged input, which resolves to the same settings.
+  const std::string checkpoint_config =
+      info.config_text == config.text
+          ? info.config_text
+          : coopt_config_from_text(info.config_text, (fs::path(info.directory) / "trainer.yaml").string()).text;
+  if (checkpoint_config != config.text)
+    throw std::runtime_error(run_dir + ": the checkpoint was written by another configuration (" +
+                             first_difference(config.text, checkpoint_config) + ")");
 }
 
 void truncate_csv_rows(const std::string& path, int rows) {
@@ -228,7 +230,8 @@ void RunStore::create(const CooptConfig& config) const {
   // otherwise start its CSV files and checkpoint over.
   if (fs::exists(path("config.yaml")))
     throw std::runtime_error(dir_ + ": already holds a run (config.yaml); resume it instead of starting it again");
-  write_file_atomic(path("config.yaml"), config.text + "\n");
+  write_file_atomic(path("config.yaml"), "# The run's resolved config: every setting, defaults included (comorph config keys).\n" +
+                                           config.text + "\n");
   report::RunInfo info;
   info.name = fs::path(dir_).filename().string();
   info.kind = name_of(config.trainer.mode);
