@@ -1,5 +1,6 @@
 #include "coopt/config.hpp"
 
+#include <algorithm>
 #include <any>
 #include <filesystem>
 #include <stdexcept>
@@ -380,6 +381,15 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
 
 CooptConfig load_coopt_config(const std::string& path, const std::vector<std::string>& sets) {
   return coopt_config_from_text(read_text_file(path), path, sets);
+}
+
+std::vector<double> stair_heights(const CooptConfig& config) {
+  if (config.trainer.stair_height > 0) return {config.trainer.stair_height};
+  const auto drawn = config.env.scene.stair_heights();
+  std::vector<double> heights(drawn.begin(), drawn.end());
+  std::sort(heights.begin(), heights.end());
+  heights.erase(std::unique(heights.begin(), heights.end()), heights.end());
+  return heights;
 }
 
 std::vector<SettingsSection> settings_sections(const CooptConfig& config) {

@@ -217,6 +217,11 @@ CooptConfig load_coopt_config(const std::string& path, const std::vector<std::st
 CooptConfig coopt_config_from_text(const std::string& text, const std::string& source,
                                    const std::vector<std::string>& sets = {});
 
+// The stair heights of the run's episodes, m, ascending: trainer.stair_height
+// when it is fixed, else the distinct heights of env.scene. Evaluations and
+// their summaries report each.
+std::vector<double> stair_heights(const CooptConfig& config);
+
 // A section of a config as `comorph config keys` and docs/config.md list it.
 struct SettingsSection {
   std::string name;   // "trainer", "env.robot", "td3", ...
