@@ -144,8 +144,9 @@ struct TrainerTiming {
 
 class Trainer {
  public:
-  // run_dir must exist. The trainer is its only writer (coopt/run_store.hpp):
-  // config.yaml, run.yaml, episodes.csv, evaluations.csv and checkpoint/.
+  // run_dir must exist. The trainer writes, through coopt/run_store.hpp,
+  // config.yaml, run.yaml, episodes.csv, evaluations.csv and checkpoint/
+  // (`comorph eval` adds its files beside them).
   Trainer(const CooptConfig& config, const std::string& run_dir, TrainerCallbacks callbacks = {});
   ~Trainer();
   // Loads run_dir's latest checkpoint; throws (naming the difference) when it
