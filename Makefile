@@ -6,7 +6,7 @@ BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc)
 CMAKE_ARGS ?=
 
-.PHONY: run test deps build bench clean
+.PHONY: run test deps build bench config-doc clean
 
 deps:
 	bash scripts/install-deps.sh
@@ -25,6 +25,10 @@ test: build
 
 bench: build
 	bash scripts/run-benchmarks.sh $(BUILD_DIR)
+
+# docs/config.md, the list of every setting (a test compares it with the code).
+config-doc: build
+	$(BUILD_DIR)/apps/comorph config keys --markdown > docs/config.md
 
 clean:
 	rm -rf $(BUILD_DIR)

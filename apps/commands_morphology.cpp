@@ -1,4 +1,5 @@
-// `comorph config ...`: write and check configuration files.
+// `comorph config ...`: write and check robot configuration files; list the
+// settings of a run's config file.
 #include <fmt/format.h>
 
 #include <iostream>
@@ -6,6 +7,7 @@
 
 #include "command_registry.hpp"
 #include "common/resources.hpp"
+#include "coopt/config_reference.hpp"
 #include "morphology/configuration.hpp"
 #include "sim/mjcf.hpp"
 #include "sim/model.hpp"
@@ -29,7 +31,8 @@ void validate_file(const std::string& path, const std::string& config_dir) {
 }
 
 comorph::cli::CommandRegistration registration{[](CLI::App& app) {
-  auto* config = app.add_subcommand("config", "write or check robot configuration files (C_a, C_s)");
+  auto* config = app.add_subcommand(
+      "config", "write or check robot configuration files (C_a, C_s); list the settings of a run's config");
   config->require_subcommand(1);
 
   auto* chain = config->add_subcommand("chain", "print the YAML of a chain of N modules");
@@ -45,6 +48,24 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   check->add_option("file", path, "configuration YAML")->required();
   check->add_option("--config-dir", config_dir, cli::kConfigDirHelp);
   check->callback([] { validate_file(path, config_dir); });
+
+  auto* keys = config->add_subcommand(
+      "keys", "list every setting of a run's config file: key, default, type and range, meaning (docs/config.md)");
+  static std::string preset;
+  static bool markdown = false;
+  keys->add_option("--preset", preset, "also show this preset's values, '*' where they differ from the default");
+  keys->add_flag("--markdown", markdown, "print docs/config.md (the same list as Markdown)");
+  keys->callback([] {
+    if (markdown && !preset.empty()) throw CLI::ValidationError("--markdown", "lists the defaults; drop --preset");
+    if (markdown) {
+      std::cout << coopt::config_reference_markdown();
+    } else if (preset.empty()) {
+      std::cout << coopt::config_keys_text();
+    } else {
+      const coopt::CooptConfig c = coopt::load_coopt_config(preset);
+      std::cout << coopt::config_keys_text(&c);
+    }
+  });
 }};
 
 }  // namespace

@@ -95,7 +95,7 @@ std::string evaluate(const std::string& run_dir, int episodes, int seed, const s
     logs = coopt::evaluate(config, run_dir, request);
   }
   std::vector<report::EpisodeRecord> records(logs.begin(), logs.end());
-  return report::to_json(report::summarize(records, config.env.task.objective)).dump();
+  return report::to_json(report::summarize(records, config.env.task.objective, coopt::stair_heights(config))).dump();
 }
 
 }  // namespace

@@ -44,10 +44,10 @@ void write_checksums(const std::string& dir, const std::vector<std::string>& nam
   write_file_atomic((fs::path(dir) / kChecksumFile).string(), text);
 }
 
-std::string verify_checksums(const std::string& dir, bool missing_ok) {
+std::string verify_checksums(const std::string& dir) {
   namespace fs = std::filesystem;
   const fs::path list = fs::path(dir) / kChecksumFile;
-  if (!fs::exists(list)) return missing_ok ? "" : list.string() + ": missing (the checkpoint is incomplete)";
+  if (!fs::exists(list)) return list.string() + ": missing (the checkpoint is incomplete)";
   std::istringstream in(read_text_file(list.string()));
   std::string line;
   int files = 0;

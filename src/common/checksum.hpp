@@ -28,8 +28,7 @@ void write_checksums(const std::string& dir, const std::vector<std::string>& nam
                      const std::map<std::string, std::string>& known);
 // "" when every file listed in dir/checksums.txt has its sum; otherwise what
 // is wrong, naming the file ("dir/motion.pt: checksum mismatch (...)").
-// `missing_ok`: a directory without checksums.txt (written before checksums
-// existed) passes.
-std::string verify_checksums(const std::string& dir, bool missing_ok = false);
+// A directory without checksums.txt is incomplete.
+std::string verify_checksums(const std::string& dir);
 
 }  // namespace comorph

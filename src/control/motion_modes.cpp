@@ -45,22 +45,26 @@ void command_to_ctrl(const MotorCommand& cmd, int modules, double* ctrl) {
   }
 }
 
-MotionParams motion_params_from_yaml(const std::string& text, const std::string& source,
-                                     MotionParams p) {
-  YamlFields f(source);
-  f.add("v_straight_max", &p.v_straight_max, 0, 5);
-  f.add("v_turn_max", &p.v_turn_max, 0, 5);
-  f.add("amplitude_max", &p.amplitude_max, 0, 3);
-  f.add("phase_max", &p.phase_max, 0, 6.3);
-  f.add("wave_frequency", &p.wave_frequency, 0, 10);
+void add_fields(YamlFields& f, MotionParams& p) {
+  f.add("v_straight_max", &p.v_straight_max, 0, 5, "m/s, straight speed at a0 = 1");
+  f.add("v_turn_max", &p.v_turn_max, 0, 5, "m/s, turning speed at a1 = 1");
+  f.add("amplitude_max", &p.amplitude_max, 0, 3, "rad, hinge wave amplitude at a2/a4 = 1 (before w3)");
+  f.add("phase_max", &p.phase_max, 0, 6.3, "rad, phase lag between neighbours at |a3| = 1 (before w4)");
+  f.add("wave_frequency", &p.wave_frequency, 0, 10, "Hz, f of the hinge wave (Eq. 5)");
   for (auto [name, w] : {std::pair<const char*, ModeWeights*>{"flat", &p.flat},
                          {"stair", &p.stair}, {"narrow", &p.narrow}}) {
     const std::string n = name;
-    f.add(n + ".w1", &w->w1, 0, 5);
-    f.add(n + ".w2", &w->w2, 0, 5);
-    f.add(n + ".w3", &w->w3, 0, 5);
-    f.add(n + ".w4", &w->w4, 0, 5);
+    f.add(n + ".w1", &w->w1, 0, 5, n + " mode: weight of the straight speed (Eq. 4)");
+    f.add(n + ".w2", &w->w2, 0, 5, n + " mode: weight of the turning speed (Eq. 4)");
+    f.add(n + ".w3", &w->w3, 0, 5, n + " mode: weight of the hinge amplitude (Eq. 5); 0 keeps the chain straight");
+    f.add(n + ".w4", &w->w4, 0, 5, n + " mode: weight of the phase lag (Eq. 5)");
   }
+}
+
+MotionParams motion_params_from_yaml(const std::string& text, const std::string& source,
+                                     MotionParams p) {
+  YamlFields f(source);
+  add_fields(f, p);
   f.apply_text(text);
   return p;
 }

@@ -23,6 +23,10 @@
 #include "common/enum_names.hpp"
 #include "morphology/configuration.hpp"  // kMaxModules
 
+namespace comorph {
+class YamlFields;
+}
+
 namespace comorph::control {
 
 inline constexpr int kActionSize = 5;
@@ -71,7 +75,10 @@ void compute_command(const MotionParams& params, MotionMode mode, const float* a
 // (4 values per module: wheel_l, wheel_r, front hinge, back hinge).
 void command_to_ctrl(const MotorCommand& cmd, int modules, double* ctrl);
 
-// YAML: fields of MotionParams, modes as nested maps (flat: {w1: 1.0, ...}).
+// Every field of MotionParams with its range and meaning, modes as nested
+// maps (flat: {w1: 1.0, ...}).
+void add_fields(YamlFields& f, MotionParams& p);
+// YAML: those fields.
 // Unknown fields and out-of-range values throw naming the file and the field.
 MotionParams motion_params_from_yaml(const std::string& text, const std::string& source_name,
                                      MotionParams defaults = {});

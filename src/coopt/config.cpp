@@ -1,7 +1,10 @@
 #include "coopt/config.hpp"
 
+#include <algorithm>
+#include <any>
 #include <filesystem>
 #include <stdexcept>
+#include <type_traits>
 
 #include "sim/params.hpp"
 #include "common/resources.hpp"
@@ -58,63 +61,91 @@ void check_keys(const YAML::Node& node, const std::string& source, const std::st
   if (!node || node.IsNull()) return;
   if (!node.IsMap()) fail(source, prefix.empty() ? "<root>" : prefix, "expected a mapping");
   for (const auto& kv : node) {
-    const std::string k = kv.first.as<std::string>();
+    const std::string k = kv.first.Scalar();  // parse_yaml refused keys that are not names
     bool ok = false;
     for (const auto& a : allowed) ok = ok || a == k;
     if (!ok) fail(source, prefix.empty() ? k : prefix + "." + k, "unknown field");
   }
 }
 
-std::string dump(const YAML::Node& n) {
-  if (!n || n.IsNull()) return "";
-  YAML::Emitter e;
-  e << n;
-  return e.c_str();
+}  // namespace
+
+void add_fields(YamlFields& f, TrainerParams& p) {
+  f.add("mode", &p.mode, "hierarchical (the DQN picks the chain) | fixed (a chain of fixed_modules, no DQN)");
+  f.add("fixed_modules", &p.fixed_modules, kMinModules, kMaxModules, "chain length of the fixed baseline");
+  f.add("motion_algo", &p.motion_algo, "the motion learner: a registered learner of continuous actions (td3, sac)");
+  f.add("seed", &p.seed, 0, kMaxSeed, "seeds the learners, the trainer's RNG and the training scenes");
+  f.add("warmup_episodes", &p.warmup_episodes, 0, kMaxEpisodes,
+        "episodes before learning acts (random actions, or the pilot: warmup_policy)");
+  f.add("episodes", &p.episodes, 0, kMaxEpisodes, "training episodes after the warm-up");
+  f.add("sync_interval", &p.sync_interval, 1, 100000,
+        "control steps between hand-overs of transitions to the learner thread");
+  f.add("learner_thread", &p.learner_thread, "run the motion updates on a second thread (same results as inline)");
+  f.add("torch_threads", &p.torch_threads, 1, 64, "torch intra-op threads per thread");
+  f.add("simulation_threads", &p.simulation_threads, 1, 64,
+        "threads simulating episodes for the one learner (a seed repeats its numbers for a given count)");
+  f.add("motion_image", &p.motion_image, "the motion model sees the depth image (CNN) beside the state");
+  f.add("config_vector", &p.config_vector, "the DQN sees [C_n / 10, scene one-hot] beside its image");
+  f.add("motion_clearance", &p.motion_clearance,
+        "the motion model sees the clearance row (nearest depth per column, or the obstacle scan)");
+  f.add("normalize_state", &p.normalize_state, "scale the state's fields to about [-1, 1]");
+  f.add("decision_camera", &p.decision_camera, "the DQN sees the decision camera (env.robot.decision_*)");
+  f.add("warmup_policy", &p.warmup_policy,
+        "who drives the warm-up: random (uniform actions, the paper) | scripted (the pilot, plus noise)");
+  f.add("warmup_noise", &p.warmup_noise, 0.0, 2.0, "std of the noise on the pilot's actions, action units");
+  f.add("scripted_interval", &p.scripted_interval, 0, kMaxEpisodes,
+        "after the warm-up, every this-many-th episode is the pilot's too; 0 = none");
+  f.add("pilot_random_configs", &p.pilot_random_configs,
+        "those pilot episodes draw their chains uniformly instead of asking the DQN");
+  f.add("pilot_gait_per_modules", &p.pilot_gait_per_modules,
+        "the pilot climbs with each chain length's searched gait (else one gait for all)");
+  f.add("pilot_flat_steering", &p.pilot_flat_steering,
+        "how the pilot steers on the flat area: planned (on the true layout) | scan (by the obstacle scan)");
+  f.add("pilot_stair_steering", &p.pilot_stair_steering,
+        "how the pilot steers while climbing: straight | scan (around obstacles on the treads)");
+  f.add("pilot_labels", &p.pilot_labels,
+        "every transition carries the pilot's action as behaviour-cloning target (td3.bc_weight)");
+  f.add("motion_n_step", &p.motion_n_step, 1, 1000, "n of the motion transitions' n-step returns; 1 = one-step TD");
+  f.add("greedy_motion_interval", &p.greedy_motion_interval, 0, kMaxEpisodes,
+        "every this-many-th model-driven episode is played without exploration noise; 0 = none");
+  f.add("config_learns_from", &p.config_learns_from,
+        "the episodes whose decisions the DQN learns from: all | model (not the pilot's) | greedy");
+  f.add("config_target", &p.config_target,
+        "the DQN's target: bootstrap (Eq. 3) | return (the R2 of the rest of the episode)");
+  f.add("config_refit_episodes", &p.config_refit_episodes, 0, kMaxEpisodes,
+        "then this many episodes in which a fresh DQN (dqn_refit:) learns on the frozen greedy motion model");
+  f.add("refit_motion_from", &p.refit_motion_from,
+        "a trained run whose motion model this run takes, frozen, to do only a refit (warm-up and episodes 0)");
+  f.add("scene_source", &p.scene_source,
+        "where scene labels come from: ground_truth (the simulator) | classifier (ResNet-18 on depth)");
+  f.add("classifier_dir", &p.classifier_dir, "directory of a trained classifier (scene_source: classifier)");
+  f.add("scenario", &p.scenario, "the training scenes: a scenario of task::kScenarios");
+  f.add("stair_height", &p.stair_height, 0, 0.5,
+        "m; 0 = drawn per episode from env.scene.stair_height_a/b/c, > 0 = this height always");
+  f.add("eval_interval", &p.eval_interval, 0, kMaxEpisodes,
+        "training episodes between periodic greedy evaluations; 0 = none");
+  f.add("eval_episodes", &p.eval_episodes, 1, 100000, "episodes per periodic evaluation (heights in turn)");
+  f.add("eval_seed", &p.eval_seed, 0, kMaxSeed, "periodic evaluation episode i has seed eval_seed + i");
+  f.add("checkpoint_interval", &p.checkpoint_interval, 1, kMaxEpisodes,
+        "training episodes between checkpoints (and at the end, and on Ctrl-C)");
+  f.add("progress_interval", &p.progress_interval, 1, kMaxEpisodes, "training episodes between progress lines");
+  f.add("env_dir", &p.env_dir, "directory of robot/scene/motion/task.yaml; empty = configs/sim");
 }
+
+void add_fields(YamlFields& f, EvalParams& p) {
+  f.add("episodes", &p.episodes, 1, 1000000, "greedy episodes of `comorph eval` (stair heights in turn)");
+  f.add("seed", &p.seed, 0, kMaxSeed, "episode i has seed seed + i");
+  f.add("workers", &p.workers, 0, 256, "threads, each with its own env and networks; 0 = one per core");
+}
+
+namespace {
 
 TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   TrainerParams p;
   const std::string pre = "trainer";
   YamlFields f(source);
-  f.add(pre + ".mode", &p.mode);
-  f.add(pre + ".fixed_modules", &p.fixed_modules, kMinModules, kMaxModules);
-  f.add(pre + ".motion_algo", &p.motion_algo);
-  f.add(pre + ".seed", &p.seed, 0, kMaxSeed);
-  f.add(pre + ".warmup_episodes", &p.warmup_episodes, 0, kMaxEpisodes);
-  f.add(pre + ".episodes", &p.episodes, 0, kMaxEpisodes);
-  f.add(pre + ".sync_interval", &p.sync_interval, 1, 100000);
-  f.add(pre + ".learner_thread", &p.learner_thread);
-  f.add(pre + ".torch_threads", &p.torch_threads, 1, 64);
-  f.add(pre + ".simulation_threads", &p.simulation_threads, 1, 64);
-  f.add(pre + ".motion_image", &p.motion_image);
-  f.add(pre + ".config_vector", &p.config_vector);
-  f.add(pre + ".motion_clearance", &p.motion_clearance);
-  f.add(pre + ".normalize_state", &p.normalize_state);
-  f.add(pre + ".decision_camera", &p.decision_camera);
-  f.add(pre + ".warmup_policy", &p.warmup_policy);
-  f.add(pre + ".warmup_noise", &p.warmup_noise, 0.0, 2.0);
-  f.add(pre + ".scripted_interval", &p.scripted_interval, 0, kMaxEpisodes);
-  f.add(pre + ".pilot_random_configs", &p.pilot_random_configs);
-  f.add(pre + ".pilot_gait_per_modules", &p.pilot_gait_per_modules);
-  f.add(pre + ".pilot_flat_steering", &p.pilot_flat_steering);
-  f.add(pre + ".pilot_stair_steering", &p.pilot_stair_steering);
-  f.add(pre + ".pilot_labels", &p.pilot_labels);
-  f.add(pre + ".motion_n_step", &p.motion_n_step, 1, 1000);
-  f.add(pre + ".greedy_motion_interval", &p.greedy_motion_interval, 0, kMaxEpisodes);
-  f.add(pre + ".config_learns_from", &p.config_learns_from);
-  f.add(pre + ".config_target", &p.config_target);
-  f.add(pre + ".config_refit_episodes", &p.config_refit_episodes, 0, kMaxEpisodes);
-  f.add(pre + ".refit_motion_from", &p.refit_motion_from);
-  f.add(pre + ".scene_source", &p.scene_source);
-  f.add(pre + ".classifier_dir", &p.classifier_dir);
-  f.add(pre + ".scenario", &p.scenario);
-  f.add(pre + ".stair_height", &p.stair_height, 0, 0.5);
-  f.add(pre + ".eval_interval", &p.eval_interval, 0, kMaxEpisodes);
-  f.add(pre + ".eval_episodes", &p.eval_episodes, 1, 100000);
-  f.add(pre + ".eval_seed", &p.eval_seed, 0, kMaxSeed);
-  f.add(pre + ".checkpoint_interval", &p.checkpoint_interval, 1, kMaxEpisodes);
-  f.add(pre + ".progress_interval", &p.progress_interval, 1, kMaxEpisodes);
-  f.add(pre + ".env_dir", &p.env_dir);
+  f.set_prefix(pre + ".");
+  add_fields(f, p);
   f.apply(n, pre + ".");
   if (!rl::has_learner(p.motion_algo) || rl::learner_entry(p.motion_algo).actions != rl::ActionKind::kContinuous) {
     std::string names;
@@ -149,35 +180,134 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
 EvalParams read_eval(const YAML::Node& n, const std::string& source) {
   EvalParams p;
   YamlFields f(source);
-  f.add("eval.episodes", &p.episodes, 1, 1000000);
-  f.add("eval.seed", &p.seed, 0, kMaxSeed);
-  f.add("eval.workers", &p.workers, 0, 256);
+  f.set_prefix("eval.");
+  add_fields(f, p);
   f.apply(n, "eval.");
   return p;
+}
+
+// Applies `node` (null: nothing) to `params` through its field list, then its checks.
+template <class Params>
+void apply_section(const YAML::Node& node, const std::string& source, Params& params) {
+  YamlFields f(source);
+  add_fields(f, params);
+  f.apply(node);
+  if constexpr (std::is_same_v<Params, sim::RobotParams> || std::is_same_v<Params, sim::SceneParams>)
+    check_fields(f, params);
 }
 
 task::EnvConfig read_env(const YAML::Node& n, const std::string& source, const std::string& env_dir) {
   task::EnvConfig c = task::load_env_config(env_dir);
   check_keys(n, source, "env", {"robot", "scene", "motion", "task"});
   if (!n || n.IsNull()) return c;
-  if (n["robot"]) c.robot = sim::robot_params_from_yaml(dump(n["robot"]), source + ": env.robot", c.robot);
-  if (n["scene"]) c.scene = sim::scene_params_from_yaml(dump(n["scene"]), source + ": env.scene", c.scene);
-  if (n["motion"])
-    c.motion = control::motion_params_from_yaml(dump(n["motion"]), source + ": env.motion", c.motion);
-  if (n["task"]) c.task = task::task_params_from_yaml(dump(n["task"]), source + ": env.task", c.task);
+  apply_section(n["robot"], source + ": env.robot", c.robot);
+  apply_section(n["scene"], source + ": env.scene", c.scene);
+  apply_section(n["motion"], source + ": env.motion", c.motion);
+  apply_section(n["task"], source + ": env.task", c.task);
   return c;
 }
 
-}  // namespace
+// The sections a config file may have beside the learners' (one per registered learner).
+const std::vector<std::string>& fixed_sections() {
+  static const std::vector<std::string> names{"trainer", "env", "perception", "dqn_refit", "eval"};
+  return names;
+}
 
-CooptConfig coopt_config_from_text(const std::string& text, const std::string& source,
-                                   const std::vector<std::string>& sets) {
+// The typed config of learner section `name` in `c` (td3, sac, dqn; another
+// registered learner's from other_learners, else its defaults).
+std::any learner_config(const CooptConfig& c, const std::string& name) {
+  if (name == "td3") return c.td3;
+  if (name == "sac") return c.sac;
+  if (name == "dqn") return c.dqn;
+  if (const auto it = c.other_learners.find(name); it != c.other_learners.end()) return it->second;
+  return rl::learner_entry(name).default_config();
+}
+
+// Binds the settings of `sections` of `c` into `f`, each under its section's
+// name. Learner configs are bound through copies kept in `learners`.
+void add_sections(YamlFields& f, CooptConfig& c, const std::vector<std::string>& sections,
+                  std::vector<std::any>& learners) {
+  learners.reserve(sections.size());  // the bound copies must not move
+  for (const std::string& section : sections) {
+    f.set_prefix(section + ".");
+    if (section == "trainer") add_fields(f, c.trainer);
+    else if (section == "eval") add_fields(f, c.eval);
+    else if (section == "env.robot") sim::add_fields(f, c.env.robot);
+    else if (section == "env.scene") sim::add_fields(f, c.env.scene);
+    else if (section == "env.motion") control::add_fields(f, c.env.motion);
+    else if (section == "env.task") task::add_fields(f, c.env.task);
+    else if (section == "perception") perception::add_fields(f, c.perception);
+    else if (section == "dqn_refit") rl::add_fields(f, c.dqn_refit);
+    else rl::learner_entry(section).add_fields(f, learners.emplace_back(learner_config(c, section)));
+  }
+}
+
+// The sections a run uses, in the order its config.yaml lists them.
+std::vector<std::string> run_sections(const CooptConfig& c) {
+  std::vector<std::string> sections{"trainer", "env.robot", "env.scene", "env.motion", "env.task", "perception",
+                                    c.trainer.motion_algo};
+  if (c.trainer.mode == TrainerMode::hierarchical) sections.push_back("dqn");
+  if (c.trainer.mode == TrainerMode::hierarchical && c.trainer.config_refit_episodes > 0)
+    sections.push_back("dqn_refit");
+  sections.push_back("eval");
+  return sections;
+}
+
+// Every setting of the run, defaults included, as YAML text.
+std::string resolved_text(const CooptConfig& config) {
+  CooptConfig c = config;
+  std::vector<std::any> learners;
+  YamlFields f("");
+  add_sections(f, c, run_sections(c), learners);
+  YAML::Emitter e;
+  e << f.values();
+  return e.c_str();
+}
+
+// Deep merge: `over`'s keys replace or, for mappings on both sides, merge into `base`'s.
+void merge_into(YAML::Node base, const YAML::Node& over) {
+  for (const auto& item : over) {
+    const std::string key = item.first.Scalar();
+    YAML::Node target = base[key];
+    if (target.IsMap() && item.second.IsMap())
+      merge_into(target, item.second);
+    else
+      base[key] = item.second;
+  }
+}
+
+CooptConfig config_from_tree(YAML::Node root, const std::string& source, const std::vector<std::string>& sets);
+
+// The YAML tree of a config file: its own keys over those of its `base:`
+// preset (a path relative to the file's directory), which must be a valid
+// config on its own. `depth` stops a preset that builds on itself.
+YAML::Node preset_tree(const std::string& text, const std::string& source, int depth) {
   YAML::Node root = parse_yaml(text, source);  // also refuses a key given twice
-  if (!root || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
-  if (!root.IsMap()) throw std::runtime_error(source + ": expected a mapping of sections");
+  if (!root || root.IsNull())
+    throw std::runtime_error(source + ": empty config (expected the sections trainer, env, perception, eval and "
+                                      "the learners', or base: PRESET)");
+  if (!root.IsMap()) throw std::runtime_error(source + ": expected a mapping of sections" + line_of(root));
+  const YAML::Node base = root["base"];
+  if (!base) return root;
+  if (!base.IsScalar() || base.Scalar().empty()) fail(source, "base", "expected a preset file name" + line_of(base));
+  if (depth >= 8) fail(source, "base", "more than 8 presets deep (a preset that builds on itself?)");
+  const std::string base_path = (std::filesystem::path(source).parent_path() / base.Scalar()).string();
+  if (!std::filesystem::is_regular_file(base_path))
+    fail(source, "base", "no preset '" + quote_value(base_path) + "'" + line_of(base));
+  YAML::Node merged = preset_tree(read_text_file(base_path), base_path, depth + 1);
+  config_from_tree(YAML::Clone(merged), base_path, {});  // a fault of the base is refused under its own name
+  root.remove("base");
+  merge_into(merged, root);
+  return merged;
+}
+
+// The config of a file's tree (preset_tree) with `sets` applied.
+CooptConfig config_from_tree(YAML::Node root, const std::string& source, const std::vector<std::string>& sets) {
   for (const auto& s : sets) apply_set(root, s);
   const std::string src = sets.empty() ? source : source + " (with --set)";
-  check_keys(root, src, "", {"trainer", "td3", "sac", "dqn", "dqn_refit", "env", "perception", "eval"});
+  std::vector<std::string> sections = fixed_sections();
+  for (const std::string& name : rl::learner_names()) sections.push_back(name);
+  check_keys(root, src, "", sections);
 
   CooptConfig c;
   c.trainer = read_trainer(root["trainer"], src);
@@ -204,23 +334,27 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
   // run before anything is written. The sections of the learners this run
   // uses must be there: their defaults are not a run's hyperparameters (and
   // td3's default random_action_steps would be refused below).
+  const auto given = [&](const std::string& name) { return root[name] && !root[name].IsNull(); };
   const auto require_section = [&](const std::string& name, const std::string& needed_by, const std::string& what) {
-    if (!root[name] || root[name].IsNull())
+    if (!given(name))
       throw std::runtime_error(src + ": no '" + name + ":' section: " + needed_by + " needs the " + what +
                                "'s hyperparameters there (configs/quick.yaml has them)");
   };
   if (c.trainer.motion_algo == "td3" || c.trainer.motion_algo == "sac")  // the typed sections; others: their defaults
     require_section(c.trainer.motion_algo, "trainer.motion_algo " + c.trainer.motion_algo, "motion model");
   if (c.trainer.mode == TrainerMode::hierarchical) require_section("dqn", "trainer.mode hierarchical", "configuration model");
-  const auto given = [&](const char* name) { return root[name] && !root[name].IsNull(); };
   c.td3 = rl::Td3Config::from_yaml(root["td3"], src + ": td3");
   c.sac = rl::SacConfig::from_yaml(root["sac"], src + ": sac");
   c.dqn = rl::DqnConfig::from_yaml(root["dqn"], src + ": dqn");
+  for (const std::string& name : rl::learner_names())
+    if (name != "td3" && name != "sac" && name != "dqn" && given(name))
+      c.other_learners[name] = rl::learner_entry(name).read_config(root[name], src + ": " + name);
   c.dqn_refit = c.dqn;
   if (given("dqn_refit")) {  // checked also where no DQN is refitted (a preset's fixed columns)
     YAML::Node merged = given("dqn") ? YAML::Clone(root["dqn"]) : YAML::Node(YAML::NodeType::Map);
-    if (!root["dqn_refit"].IsMap()) throw std::runtime_error(src + ": dqn_refit: expected a mapping of dqn keys");
-    for (const auto& kv : root["dqn_refit"]) merged[kv.first.as<std::string>()] = kv.second;
+    if (!root["dqn_refit"].IsMap())
+      throw std::runtime_error(src + ": dqn_refit: expected a mapping of dqn keys" + line_of(root["dqn_refit"]));
+    for (const auto& kv : root["dqn_refit"]) merged[kv.first.Scalar()] = kv.second;
     c.dqn_refit = rl::DqnConfig::from_yaml(merged, src + ": dqn_refit (over dqn)");
     if (c.dqn_refit.hidden_sizes != c.dqn.hidden_sizes || c.dqn_refit.image_features != c.dqn.image_features ||
         c.dqn_refit.image_fc_size != c.dqn.image_fc_size)
@@ -233,17 +367,67 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
   if (given("sac") && (c.sac.random_action_episodes != 0 || c.sac.random_action_steps != 0))
     throw std::runtime_error(src + ": field 'sac.random_action_episodes/steps': must be 0, "
                                    "the warm-up is trainer.warmup_episodes (both models)");
-  // Where no DQN is refitted (a fixed chain, or config_refit_episodes 0) dqn_refit: is no part of the run:
-  // a preset's fixed columns stay the same runs whatever it holds.
-  if (given("dqn_refit") && (c.trainer.mode != TrainerMode::hierarchical || c.trainer.config_refit_episodes == 0))
-    root.remove("dqn_refit");
-  c.text = dump(root);
+  c.text = resolved_text(c);
   c.preset = std::filesystem::path(source).stem().string();
   return c;
 }
 
+}  // namespace
+
+CooptConfig coopt_config_from_text(const std::string& text, const std::string& source,
+                                   const std::vector<std::string>& sets) {
+  return config_from_tree(preset_tree(text, source, 0), source, sets);
+}
+
 CooptConfig load_coopt_config(const std::string& path, const std::vector<std::string>& sets) {
   return coopt_config_from_text(read_text_file(path), path, sets);
+}
+
+std::vector<double> stair_heights(const CooptConfig& config) {
+  if (config.trainer.stair_height > 0) return {config.trainer.stair_height};
+  const auto drawn = config.env.scene.stair_heights();
+  std::vector<double> heights(drawn.begin(), drawn.end());
+  std::sort(heights.begin(), heights.end());
+  heights.erase(std::unique(heights.begin(), heights.end()), heights.end());
+  return heights;
+}
+
+std::vector<SettingsSection> settings_sections(const CooptConfig& config) {
+  struct About {
+    std::string section, about;
+  };
+  std::vector<About> abouts{
+      {"trainer", "The hierarchical trainer: budget, schedules, threads, the pilot, the scene source."},
+      {"env.robot", "The simulated module and its sensors (over configs/sim/robot.yaml)."},
+      {"env.scene", "The scenario's stairs, obstacles and target (over configs/sim/scene.yaml)."},
+      {"env.motion", "The motion modes: the 5-D action to wheel speeds and hinge targets (over configs/sim/motion.yaml)."},
+      {"env.task", "Rewards R1 and R2, the objective F(H), termination (over configs/sim/task.yaml)."},
+      {"perception", "The scene classifier, its training and the switch detector."}};
+  for (const std::string& name : rl::learner_names())
+    abouts.push_back({name, "Hyperparameters of the " + name + " learner (" +
+                                (rl::learner_entry(name).actions == rl::ActionKind::kDiscrete
+                                     ? "discrete actions: the configuration model; dqn_refit: takes any of these "
+                                       "keys for the refit DQN"
+                                     : "continuous actions: a motion model, trainer.motion_algo") +
+                                ")."});
+  abouts.push_back({"eval", "Defaults of `comorph eval`."});
+  CooptConfig c = config;
+  std::vector<SettingsSection> list;
+  for (const About& a : abouts) {
+    std::vector<std::any> learners;
+    YamlFields f("");
+    add_sections(f, c, {a.section}, learners);
+    list.push_back({a.section, a.about, f.settings()});
+  }
+  return list;
+}
+
+CooptConfig default_coopt_config() {
+  CooptConfig c;
+  c.env = task::load_env_config(resource_path("configs/sim"));
+  c.env_dir = resource_path("configs/sim");
+  c.text = resolved_text(c);
+  return c;
 }
 
 }  // namespace comorph::coopt

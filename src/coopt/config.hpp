@@ -1,26 +1,35 @@
 // One run of the hierarchical co-optimization = one YAML file (configs/paper.yaml,
 // quick.yaml, ci.yaml) with these sections, every key optional:
 //
+//   base:       a preset this file builds on (path relative to the file): its
+//               keys apply first, this file's over them
 //   trainer:    TrainerParams below (episodes, schedules, threads, scene source, ...)
 //   td3:        rl::Td3Config fields   (motion model, trainer.motion_algo: td3)
 //   sac:        rl::SacConfig fields   (motion model, trainer.motion_algo: sac)
 //   dqn:        rl::DqnConfig fields   (configuration model)
+//   <learner>:  the fields of any other learner in rl's registry
 //   dqn_refit:  rl::DqnConfig fields that differ for the refit DQN
 //               (trainer.config_refit_episodes); the rest are dqn:'s
 //   env:        {robot, scene, motion, task}: overrides of configs/sim/*.yaml
-//   perception: {classifier, switch_detector} (configs/perception.yaml layout)
+//   perception: {classifier, training, switch_detector} (configs/perception.yaml layout)
 //   eval:       EvalParams below
 //
+// Each section's fields are declared once, with range and meaning, by an
+// add_fields(YamlFields&, Struct&) next to its struct: the reader, `comorph
+// config keys`, docs/config.md and the resolved text below all use them.
 // `--set a.b.c=value` overrides any key (value parsed as YAML, so lists work).
 // Unknown keys and out-of-range values throw std::runtime_error naming the
-// source and the dotted key. No torch in this header: the CLI includes it.
+// source, the dotted key and the line. No torch in this header: the CLI includes it.
 #pragma once
 
+#include <any>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "common/enum_names.hpp"
+#include "common/yaml_fields.hpp"  // Setting
 #include "perception/perception_config.hpp"
 #include "rl/learner_params.hpp"
 #include "task/env_config.hpp"
@@ -183,8 +192,12 @@ struct CooptConfig {
   // The refit DQN's (trainer.config_refit_episodes): dqn: with the keys of
   // dqn_refit: over it. Its network is dqn:'s (evaluation loads either model).
   rl::DqnConfig dqn_refit;
-  // The merged YAML (file + --set): what the run directory's config.yaml holds
-  // and what a checkpoint is compared against.
+  // The sections of the other registered learners the file gives, typed by
+  // the registry (rl::LearnerEntry::read_config).
+  std::map<std::string, std::any> other_learners;
+  // The resolved config: every setting of the sections the run uses, defaults
+  // included, as YAML. What the run directory's config.yaml holds, the run's
+  // identity (a checkpoint is compared against it) and reads back to itself.
   std::string text;
   // The simulator config files the env was built from (task::env_files_text
   // of env_dir): the other half of a run's identity, compared on resume.
@@ -193,10 +206,32 @@ struct CooptConfig {
   std::string preset;                          // file stem, e.g. "quick"
 };
 
-// Loads `path`, applies `sets` ("a.b=value"), validates every section.
+// Every field of TrainerParams / EvalParams with its range and meaning.
+void add_fields(YamlFields& f, TrainerParams& p);
+void add_fields(YamlFields& f, EvalParams& p);
+
+// Loads `path` (over its base: presets), applies `sets` ("a.b=value"),
+// validates every section. An empty file is refused as such.
 CooptConfig load_coopt_config(const std::string& path, const std::vector<std::string>& sets = {});
 // The same from YAML text (source names it in errors).
 CooptConfig coopt_config_from_text(const std::string& text, const std::string& source,
                                    const std::vector<std::string>& sets = {});
+
+// The stair heights of the run's episodes, m, ascending: trainer.stair_height
+// when it is fixed, else the distinct heights of env.scene. Evaluations and
+// their summaries report each.
+std::vector<double> stair_heights(const CooptConfig& config);
+
+// A section of a config as `comorph config keys` and docs/config.md list it.
+struct SettingsSection {
+  std::string name;   // "trainer", "env.robot", "td3", ...
+  std::string about;  // one sentence
+  std::vector<Setting> settings;  // keys relative to the file's root ("trainer.episodes")
+};
+// Every section a config may have (every registered learner's too), with
+// the values of `config`.
+std::vector<SettingsSection> settings_sections(const CooptConfig& config);
+// The defaults: no file, env from configs/sim, each learner's defaults.
+CooptConfig default_coopt_config();
 
 }  // namespace comorph::coopt

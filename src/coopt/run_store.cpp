@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "common/checksum.hpp"
 #include "common/file_io.hpp"
@@ -36,8 +37,7 @@ void load_file(Model& model, const std::string& path) {
   }
 }
 
-// A learner's replay from its checkpoint's segments (rl/replay_segments.hpp;
-// an older checkpoint's learner file held it, and then there is no index).
+// A learner's replay from its checkpoint's segments (rl/replay_segments.hpp).
 // Every transition the learner counts must be back: a missing index would
 // otherwise resume with an empty buffer.
 rl::ReplaySegments load_replay(rl::Learner& learner, const std::string& name, const std::string& dir) {
@@ -70,9 +70,12 @@ std::string first_difference(const std::string& a, const std::string& b) {
 // Largest episodes.csv / evaluations.csv a resume reads (4300 episodes take ~0.5 MB).
 constexpr std::size_t kMaxRunCsvBytes = 256u << 20;
 
-constexpr const char* kEvalColumns =
-    "train_episode,env_steps,wall_s,episodes,success_0.04,success_0.06,success_0.08,success_avg,"
-    "mean_return_R1,mean_distance_fraction,mean_F,configurations";
+// The header of evaluations.csv: a success column per stair height of the run.
+std::string evaluation_columns(const CooptConfig& config) {
+  std::string columns = "train_episode,env_steps,wall_s,episodes";
+  for (const double h : stair_heights(config)) columns += ",success_" + report::stair_key(h);
+  return columns + ",success_avg,mean_return_R1,mean_distance_fraction,mean_F,configurations";
+}
 
 // "0.53", or "-" for NaN (no episode of that kind).
 std::string format_rate(double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.2f}", v); }
@@ -92,7 +95,7 @@ std::vector<std::string> csv_data_lines(const std::string& path, std::string& he
 // rows must all be there and be rows of these files: a shorter file would
 // leave a permanent gap, a garbled one would be kept and appended to.
 void check_rows_for_resume(const std::string& episodes_csv, const std::string& evaluations_csv,
-                           const CheckpointInfo& checkpoint) {
+                           const CheckpointInfo& checkpoint, const std::string& columns) {
   std::string header;
   const auto episodes = csv_data_lines(episodes_csv, header);
   if (static_cast<int>(episodes.size()) < checkpoint.episodes)
@@ -114,7 +117,6 @@ void check_rows_for_resume(const std::string& episodes_csv, const std::string& e
                                            episodes_csv, i + 2, records[static_cast<std::size_t>(i)].episode, i));
 
   const auto evaluations = csv_data_lines(evaluations_csv, header);
-  const std::string columns = kEvalColumns;
   if (checkpoint.evaluations > 0 && header != columns)
     throw std::runtime_error(evaluations_csv + ":1: not the header of evaluations.csv; refusing to resume");
   if (static_cast<int>(evaluations.size()) < checkpoint.evaluations)
@@ -150,9 +152,6 @@ CheckpointInfo read_checkpoint_info(const std::string& run_dir) {
     std::string problem;
     if (!fs::exists(fs::path(candidate) / "trainer.yaml")) {
       problem = candidate + ": incomplete (no trainer.yaml)";
-    } else if (!fs::exists(fs::path(candidate) / kChecksumFile)) {
-      std::fprintf(stderr, "comorph: warning: %s has no %s (written before checkpoints had checksums): not verified\n",
-                   candidate.c_str(), kChecksumFile);
     } else {
       problem = verify_checksums(candidate);
     }
@@ -175,8 +174,7 @@ CheckpointInfo read_checkpoint_info(const std::string& run_dir) {
     info.env_steps = n["env_steps"].as<std::int64_t>();
     info.wall_s = n["wall_s"].as<double>();
     info.config_text = n["config"].as<std::string>();
-    if (n["env_files"]) info.env_text = n["env_files"].as<std::string>();
-    info.has_env_text = static_cast<bool>(n["env_files"]);
+    info.env_text = n["env_files"].as<std::string>();
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(path + ": unreadable checkpoint: " + e.msg);
   }
@@ -200,16 +198,19 @@ void check_checkpoint_counts(const CheckpointInfo& info, const CooptConfig& conf
 }
 
 void check_same_run(const CheckpointInfo& info, const CooptConfig& config, const std::string& run_dir) {
-  if (info.config_text != config.text)
-    throw std::runtime_error(run_dir + ": the checkpoint was written by another configuration (" +
-                             first_difference(config.text, info.config_text) + ")");
-  if (!info.has_env_text)
-    std::fprintf(stderr, "comorph: warning: %s predates simulator-config checks: configs/sim not compared\n",
-                 info.directory.c_str());
-  else if (info.env_text != config.env_text)
+  if (info.env_text != config.env_text)
     throw std::runtime_error(run_dir + ": the simulator config (" + config.env_dir +
                              ") changed since the checkpoint was written (" +
                              first_difference(config.env_text, info.env_text) + ")");
+  // Checkpoints hold the resolved config; those written before configs were
+  // resolved hold the merged input, which resolves to the same settings.
+  const std::string checkpoint_config =
+      info.config_text == config.text
+          ? info.config_text
+          : coopt_config_from_text(info.config_text, (fs::path(info.directory) / "trainer.yaml").string()).text;
+  if (checkpoint_config != config.text)
+    throw std::runtime_error(run_dir + ": the checkpoint was written by another configuration (" +
+                             first_difference(config.text, checkpoint_config) + ")");
 }
 
 void truncate_csv_rows(const std::string& path, int rows) {
@@ -232,7 +233,8 @@ void RunStore::create(const CooptConfig& config) const {
   // otherwise start its CSV files and checkpoint over.
   if (fs::exists(path("config.yaml")))
     throw std::runtime_error(dir_ + ": already holds a run (config.yaml); resume it instead of starting it again");
-  write_file_atomic(path("config.yaml"), config.text + "\n");
+  write_file_atomic(path("config.yaml"), "# The run's resolved config: every setting, defaults included (comorph config keys).\n" +
+                                           config.text + "\n");
   report::RunInfo info;
   info.name = fs::path(dir_).filename().string();
   info.kind = name_of(config.trainer.mode);
@@ -244,7 +246,7 @@ void RunStore::create(const CooptConfig& config) const {
   info.notes = "scene source: " + name_of(config.trainer.scene_source);
   report::write_run_info(path("run.yaml"), info);
   report::write_episodes_csv(path("episodes.csv"), {});
-  write_file_atomic(path("evaluations.csv"), std::string(kEvalColumns) + "\n");
+  write_file_atomic(path("evaluations.csv"), evaluation_columns(config) + "\n");
 }
 
 void RunStore::append_episode(const EpisodeLog& log) const {
@@ -262,7 +264,7 @@ std::string RunStore::append_evaluation(const CooptConfig& config, const Evaluat
     ret += l.return_R1;
     dist += l.distance_fraction;
   }
-  const auto m = report::summarize(records, config.env.task.objective);
+  const auto m = report::summarize(records, config.env.task.objective, stair_heights(config));
   const double n = static_cast<double>(e.episodes.size());
   std::string configs;  // "0.04:4x2|6->2x1 0.06:..."
   for (const auto& [height, seqs] : m.configurations) {
@@ -273,15 +275,18 @@ std::string RunStore::append_evaluation(const CooptConfig& config, const Evaluat
       first = false;
     }
   }
-  const auto rate = [&](const char* key) { return format_rate(m.success_rate.at(key)); };
+  std::vector<std::string> heights, rates;  // in the order of the run's heights
+  for (const double h : stair_heights(config)) {
+    heights.push_back(report::stair_key(h));
+    rates.push_back(format_rate(m.success_rate.at(heights.back())));
+  }
+  const std::string avg = format_rate(m.success_rate.at("avg"));
   append_file(path("evaluations.csv"),
-              fmt::format("{},{},{:.1f},{},{},{},{},{},{:.2f},{:.3f},{:.3f},{}\n", e.train_episode, e.env_steps,
-                          e.wall_s, e.episodes.size(), rate("0.04"), rate("0.06"), rate("0.08"), rate("avg"),
-                          ret / n, dist / n, m.F, configs));
+              fmt::format("{},{},{:.1f},{},{},{},{:.2f},{:.3f},{:.3f},{}\n", e.train_episode, e.env_steps, e.wall_s,
+                          e.episodes.size(), fmt::join(rates, ","), avg, ret / n, dist / n, m.F, configs));
   return fmt::format(
-      "evaluation after {} episodes: success 0.04/0.06/0.08 m = {}/{}/{} (avg {}), return {:.1f}, distance {:.0f} %, "
-      "configurations {}",
-      e.train_episode, rate("0.04"), rate("0.06"), rate("0.08"), rate("avg"), ret / n, 100.0 * dist / n, configs);
+      "evaluation after {} episodes: success {} m = {} (avg {}), return {:.1f}, distance {:.0f} %, configurations {}",
+      e.train_episode, fmt::join(heights, "/"), fmt::join(rates, "/"), avg, ret / n, 100.0 * dist / n, configs);
 }
 
 void RunStore::save_checkpoint(TrainingState& s, const CooptConfig& config, double wall_s) const {
@@ -362,7 +367,7 @@ void RunStore::load_checkpoint(TrainingState& s, const CooptConfig& config) cons
   } catch (const std::exception& e) {
     throw std::runtime_error(std::string(e.what()) + "; refusing to resume");
   }
-  check_rows_for_resume(path("episodes.csv"), path("evaluations.csv"), info);
+  check_rows_for_resume(path("episodes.csv"), path("evaluations.csv"), info, evaluation_columns(config));
   load_learner_file(*s.motion, (fs::path(info.directory) / "motion.pt").string());
   if (!s.motion_on_policy) s.motion_segments = load_replay(*s.motion, "motion", info.directory);
   load_learner_file(*s.agent.motion, (fs::path(info.directory) / "motion_actor.pt").string());

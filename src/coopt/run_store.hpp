@@ -1,5 +1,5 @@
-// The run directory: everything the trainer writes there goes through one
-// RunStore. It starts the run (config.yaml, run.yaml and the headers of
+// The run directory as the trainer writes it: everything the trainer writes
+// there goes through one RunStore (`comorph eval` adds eval-* files beside). It starts the run (config.yaml, run.yaml and the headers of
 // episodes.csv and evaluations.csv; formats in report/), appends their rows,
 // writes the checkpoint (checkpoint.tmp, then swapped in, the
 // previous one kept as checkpoint.old; replay buffers as segments, checksums

@@ -250,7 +250,6 @@ Trainer::~Trainer() = default;
 
 void Trainer::resume() { impl_->load_checkpoint(); }
 int Trainer::episodes_done() const { return impl_->state.episode; }
-int Trainer::evaluations_done() const { return impl_->state.evaluations; }
 std::int64_t Trainer::env_steps() const { return impl_->state.steps; }
 double Trainer::wall_s() const { return impl_->wall(); }
 

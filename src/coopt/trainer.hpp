@@ -95,9 +95,8 @@ struct CheckpointInfo {
   int evaluations = 0;          // periodic evaluations done (= rows of evaluations.csv)
   std::int64_t env_steps = 0;   // training control steps done
   double wall_s = 0;            // training wall time so far, s
-  std::string config_text;      // the merged config the run was started with
+  std::string config_text;      // the config the run was started with (resolved; merged input before resolving)
   std::string env_text;         // CooptConfig::env_text of the run (the simulator config files)
-  bool has_env_text = false;    // false: written before env_text was stored (not compared)
   std::string directory;        // where it was read from
 };
 // Reads the latest complete checkpoint of a run whose files match their
@@ -109,7 +108,8 @@ CheckpointInfo read_checkpoint_info(const std::string& run_dir);
 // training episodes, 0 <= evaluations <= episodes and steps, wall time >= 0.
 void check_checkpoint_counts(const CheckpointInfo& info, const CooptConfig& config);
 // Throws (naming the first differing line) when the checkpoint was written by
-// another merged config or another simulator config (configs/sim/*.yaml).
+// a config that resolves to other settings, or by another simulator config
+// (configs/sim/*.yaml).
 void check_same_run(const CheckpointInfo& info, const CooptConfig& config, const std::string& run_dir);
 // Keeps the header and the first `rows` data rows of a CSV file (resume after a kill).
 void truncate_csv_rows(const std::string& path, int rows);
@@ -144,8 +144,9 @@ struct TrainerTiming {
 
 class Trainer {
  public:
-  // run_dir must exist. The trainer is its only writer (coopt/run_store.hpp):
-  // config.yaml, run.yaml, episodes.csv, evaluations.csv and checkpoint/.
+  // run_dir must exist. The trainer writes, through coopt/run_store.hpp,
+  // config.yaml, run.yaml, episodes.csv, evaluations.csv and checkpoint/
+  // (`comorph eval` adds its files beside them).
   Trainer(const CooptConfig& config, const std::string& run_dir, TrainerCallbacks callbacks = {});
   ~Trainer();
   // Loads run_dir's latest checkpoint; throws (naming the difference) when it
@@ -161,7 +162,6 @@ class Trainer {
   bool run(const std::atomic<bool>* stop = nullptr);
 
   int episodes_done() const;
-  int evaluations_done() const;
   std::int64_t env_steps() const;
   double wall_s() const;  // training wall time including resumed parts
   TrainerTiming timing() const;

@@ -15,6 +15,7 @@ rl::LearnerArgs motion_args(const CooptConfig& c, std::uint64_t seed) {
   a.seed = seed;
   if (c.trainer.motion_algo == "td3") a.config = c.td3;
   if (c.trainer.motion_algo == "sac") a.config = c.sac;
+  if (const auto it = c.other_learners.find(c.trainer.motion_algo); it != c.other_learners.end()) a.config = it->second;
   a.random_action_episodes = c.trainer.warmup_episodes;  // the trainer's warm-up replaces the config's
   return a;
 }

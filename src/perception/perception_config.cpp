@@ -35,31 +35,40 @@ std::string TrainParams::validate() const {
   return "";
 }
 
-PerceptionConfig perception_config_from_yaml(const YAML::Node& root, const std::string& source) {
-  PerceptionConfig cfg;
+void add_fields(YamlFields& f, PerceptionConfig& cfg) {
   ClassifierParams& c = cfg.classifier;
   TrainParams& t = cfg.training;
   SwitchDetectorParams& d = cfg.switch_detector;
-  // Ranges and cross-field rules live in the structs' validate(); here: keys and types.
+  // Ranges and cross-field rules live in the structs' validate() (also for
+  // parameters set in code); here: keys, types and meanings.
+  f.add("classifier.image_size", &c.image_size, "pixels, side of the square depth image classified (8..256)");
+  f.add("classifier.classes", &c.classes, "scene classes (2..255)");
+  f.add("classifier.class_names", &c.class_names, "a name per class (empty: class 0, class 1, ...)");
+  f.add("classifier.width", &c.width, "channels of the ResNet's first stage (1..512; the standard ResNet-18: 64)");
+  f.add("classifier.device", &c.device, "torch device (cpu, cuda, cuda:N)");
+  f.add("training.epochs", &t.epochs, "passes over the training set (>= 1)");
+  f.add("training.batch_size", &t.batch_size, "images per Adam step (>= 2, batch norm)");
+  f.add("training.learning_rate", &t.learning_rate, "Adam step size at the start (> 0)");
+  f.add("training.cosine_schedule", &t.cosine_schedule, "cosine decay of the step size to 0 over all batches");
+  f.add("training.weight_decay", &t.weight_decay, "L2 penalty of Adam (>= 0)");
+  f.add("training.eval_fraction", &t.eval_fraction, "fraction held out for evaluation without an evaluation set, [0, 1)");
+  f.add("training.seed", &t.seed, "seed of weight init, split and minibatch shuffling");
+  f.add("training.threads", &t.threads, "torch intra-op threads (>= 1)");
+  f.add("training.progress", &t.progress, "print one line per epoch");
+  f.add("switch_detector.interval", &d.interval, "control steps between two switch decisions (paper: 100)");
+  f.add("switch_detector.window", &d.window, "frame labels looked at per decision (paper: 10)");
+  f.add("switch_detector.agreement", &d.agreement,
+        "fraction of the window that must agree, strictly exceeded (paper: 0.7), [0, 1)");
+}
+
+PerceptionConfig perception_config_from_yaml(const YAML::Node& root, const std::string& source) {
+  PerceptionConfig cfg;
   YamlFields f(source);
-  f.add("classifier.image_size", &c.image_size);
-  f.add("classifier.classes", &c.classes);
-  f.add("classifier.class_names", &c.class_names);
-  f.add("classifier.width", &c.width);
-  f.add("classifier.device", &c.device);
-  f.add("training.epochs", &t.epochs);
-  f.add("training.batch_size", &t.batch_size);
-  f.add("training.learning_rate", &t.learning_rate);
-  f.add("training.cosine_schedule", &t.cosine_schedule);
-  f.add("training.weight_decay", &t.weight_decay);
-  f.add("training.eval_fraction", &t.eval_fraction);
-  f.add("training.seed", &t.seed);
-  f.add("training.threads", &t.threads);
-  f.add("training.progress", &t.progress);
-  f.add("switch_detector.interval", &d.interval);
-  f.add("switch_detector.window", &d.window);
-  f.add("switch_detector.agreement", &d.agreement);
+  add_fields(f, cfg);
   f.apply(root);
+  const ClassifierParams& c = cfg.classifier;
+  const TrainParams& t = cfg.training;
+  const SwitchDetectorParams& d = cfg.switch_detector;
   for (const std::string& err : {c.validate(), t.validate(), d.validate()})
     if (!err.empty()) throw std::runtime_error(source + ": " + err);
   return cfg;

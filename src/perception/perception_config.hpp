@@ -17,6 +17,10 @@
 #include "perception/params.hpp"
 #include "perception/switch_detector.hpp"
 
+namespace comorph {
+class YamlFields;
+}
+
 namespace comorph::perception {
 
 struct PerceptionConfig {
@@ -25,6 +29,8 @@ struct PerceptionConfig {
   SwitchDetectorParams switch_detector;
 };
 
+// Every field of PerceptionConfig with its meaning (validate() checks the ranges).
+void add_fields(YamlFields& f, PerceptionConfig& config);
 PerceptionConfig load_perception_config(const std::string& path);
 // `node` is the mapping above (e.g. the `perception:` section of a preset).
 PerceptionConfig perception_config_from_yaml(const YAML::Node& node, const std::string& source);

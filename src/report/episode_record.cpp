@@ -1,6 +1,7 @@
 #include "report/episode_record.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -51,6 +52,9 @@ T parse_number(const Field& f, const char* name) {
   if (f.text.empty() || ec != std::errc() || ptr != end)
     throw FieldError(f.column, fmt::format("column '{}': '{}' is not a valid {}", name, f.text,
                                            std::is_floating_point_v<T> ? "number" : "integer"));
+  if constexpr (std::is_floating_point_v<T>)
+    if (!std::isfinite(value))
+      throw FieldError(f.column, fmt::format("column '{}': '{}' is not a finite number", name, f.text));
   return value;
 }
 
@@ -136,6 +140,7 @@ std::vector<EpisodeRecord> read_episodes_csv(std::istream& in, const std::string
   }
 
   std::vector<EpisodeRecord> records;
+  std::map<int, int> line_of_episode;  // an episode's row may appear once
   while (std::getline(in, line)) {
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -147,6 +152,8 @@ std::vector<EpisodeRecord> read_episodes_csv(std::istream& in, const std::string
       auto f = [&](int k) -> const Field& { return fields[at[k]]; };
       EpisodeRecord r;
       r.episode = parse_number<int>(f(0), "episode");
+      if (const auto [it, fresh] = line_of_episode.emplace(r.episode, line_no); !fresh)
+        throw FieldError(f(0).column, fmt::format("episode {} appears twice (also on line {})", r.episode, it->second));
       r.seed = parse_number<std::uint64_t>(f(1), "seed");
       r.scenario = std::string(f(2).text);
       r.stair_height_m = parse_number<double>(f(3), "stair_height_m");

@@ -23,7 +23,9 @@ void write_episodes_csv(std::ostream& out, const std::vector<EpisodeRecord>& rec
 void write_episodes_csv(const std::string& path, const std::vector<EpisodeRecord>& records);
 
 // Reads what write_episodes_csv writes. The header must list the columns
-// above (in any order; extra columns are ignored). Errors throw with
+// above (in any order; extra columns are ignored). Refuses an empty file, a
+// row with too few or too many fields, a value that is not a number or not
+// finite (nan, inf) and an episode whose row appears twice. Errors throw with
 // "source:line:column: message" (column = 1-based character position).
 std::vector<EpisodeRecord> read_episodes_csv(std::istream& in, const std::string& source_name);
 std::vector<EpisodeRecord> read_episodes_csv(const std::string& path);

@@ -1,5 +1,7 @@
 #include "report/metrics.hpp"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -23,6 +25,13 @@ double read_number_or_null(const nlohmann::json& j, const std::string& key, cons
   return j.get<double>();
 }
 
+// A stair-height key: a number of metres (stair_key's text).
+bool is_stair_key(const std::string& key) {
+  double value = 0;
+  const auto [end, ec] = std::from_chars(key.data(), key.data() + key.size(), value);
+  return ec == std::errc() && end == key.data() + key.size() && value >= 0;
+}
+
 const nlohmann::json& need(const nlohmann::json& j, const std::string& key, const std::string& where) {
   auto it = j.find(key);
   if (it == j.end()) throw std::runtime_error(fmt::format("{}: missing key '{}'", where, key));
@@ -35,22 +44,30 @@ double objective_F(const EpisodeRecord& e, const task::ObjectiveWeights& w) {
   return task::objective(w, e.time_s, e.energy_J, e.distance_fraction);
 }
 
-const std::vector<std::string>& paper_stair_keys() {
-  static const std::vector<std::string> keys = {"0.04", "0.06", "0.08"};
+std::string stair_key(double stair_height_m) { return fmt::format("{}", stair_height_m); }
+
+std::vector<std::string> stair_keys(const EvalSummary& summary) {
+  std::vector<std::pair<double, std::string>> heights;
+  for (const auto& [key, rate] : summary.success_rate)
+    if (key != "avg") heights.emplace_back(std::stod(key), key);
+  std::sort(heights.begin(), heights.end());
+  std::vector<std::string> keys;
+  for (const auto& [height, key] : heights) keys.push_back(key);
   return keys;
 }
 
-std::string stair_key(double stair_height_m) { return fmt::format("{:.2f}", stair_height_m); }
-
-EvalSummary summarize(const std::vector<EpisodeRecord>& records, const task::ObjectiveWeights& weights) {
+EvalSummary summarize(const std::vector<EpisodeRecord>& records, const task::ObjectiveWeights& weights,
+                      const std::vector<double>& stair_heights) {
   EvalSummary m;
   m.episodes = static_cast<int>(records.size());
   std::map<std::string, std::pair<int, int>> per_height;  // key -> (successes, episodes)
-  for (const auto& k : paper_stair_keys()) per_height[k] = {0, 0};
+  std::map<std::string, std::pair<double, int>> first;    // key -> (sum of first modules, episodes with a choice)
+  for (const double h : stair_heights) {
+    per_height[stair_key(h)] = {0, 0};
+    first[stair_key(h)] = {0.0, 0};
+  }
   double time_sum = 0, energy_sum = 0, F_sum = 0;
   int successes = 0, climbed = 0, shed = 0;
-  std::map<std::string, std::pair<double, int>> first;  // key -> (sum of first modules, episodes with a choice)
-  for (const auto& k : paper_stair_keys()) first[k] = {0.0, 0};
   for (const auto& r : records) {
     const std::string key = stair_key(r.stair_height_m);
     auto& [wins, count] = per_height[key];
@@ -64,6 +81,7 @@ EvalSummary summarize(const std::vector<EpisodeRecord>& records, const task::Obj
     F_sum += objective_F(r, weights);
     ++m.configurations[key][configuration_sequence(r.configurations)];
     ++m.terminations[r.termination];
+    first[key];  // a height seen has a first_modules entry, NaN without choices
     if (!r.configurations.empty()) {
       first[key].first += r.configurations.front();
       ++first[key].second;
@@ -114,10 +132,12 @@ EvalSummary metrics_from_json(const nlohmann::json& j, const std::string& where)
   EvalSummary m;
   const auto& rates = need(j, "success_rate", where);
   if (!rates.is_object()) throw std::runtime_error(fmt::format("{}: key 'success_rate' is not an object", where));
-  for (const auto& k : paper_stair_keys()) need(rates, k, where + " success_rate");
   need(rates, "avg", where + " success_rate");
-  for (auto it = rates.begin(); it != rates.end(); ++it)
+  for (auto it = rates.begin(); it != rates.end(); ++it) {
+    if (it.key() != "avg" && !is_stair_key(it.key()))
+      throw std::runtime_error(fmt::format("{}: key 'success_rate.{}' is not a stair height (m) or avg", where, it.key()));
     m.success_rate[it.key()] = read_number_or_null(it.value(), "success_rate." + it.key(), where);
+  }
   m.time_s = read_number_or_null(need(j, "time_s", where), "time_s", where);
   m.energy_J = read_number_or_null(need(j, "energy_J", where), "energy_J", where);
   m.F = read_number_or_null(need(j, "F", where), "F", where);

@@ -20,18 +20,17 @@ namespace comorph::report {
 // time, energy and distance fraction.
 double objective_F(const EpisodeRecord& episode, const task::ObjectiveWeights& weights);
 
-// The three stair heights of the paper's protocol, as summary keys.
-const std::vector<std::string>& paper_stair_keys();  // {"0.04", "0.06", "0.08"}
-// Summary key of a stair height: metres with two decimals ("0.06").
+// Summary key of a stair height: metres, the shortest text that reads back
+// as the same number ("0.06", "0.1").
 std::string stair_key(double stair_height_m);
 
 // What an evaluation measured over its episodes (the eval-<scenario>.json).
 struct EvalSummary {
   int episodes = 0;  // episodes summarised
-  // Success fraction (0..1) per stair-height key; always has "0.04", "0.06",
-  // "0.08" (NaN when no episode had that height) and any other height seen;
-  // "avg" = mean of the per-height fractions of the heights that had episodes
-  // (the paper's "Success avg").
+  // Success fraction (0..1) per stair-height key: every height summarize()
+  // was given (NaN when no episode had it) and any other height seen; "avg" =
+  // mean of the per-height fractions of the heights that had episodes (the
+  // paper's "Success avg").
   std::map<std::string, double> success_rate;
   double time_s = 0;    // mean time of the SUCCESSFUL episodes, seconds; NaN when none succeeded
   double energy_J = 0;  // mean energy of the SUCCESSFUL episodes, joules; NaN when none succeeded
@@ -47,7 +46,12 @@ struct EvalSummary {
   double shed_after_stairs = 0;
 };
 
-EvalSummary summarize(const std::vector<EpisodeRecord>& records, const task::ObjectiveWeights& weights = {});
+// `stair_heights`: the heights the episodes were drawn from (the run's
+// env.scene), each reported even when no episode had it.
+EvalSummary summarize(const std::vector<EpisodeRecord>& records, const task::ObjectiveWeights& weights = {},
+                      const std::vector<double>& stair_heights = {});
+// The stair-height keys of a summary's success_rate, lowest height first.
+std::vector<std::string> stair_keys(const EvalSummary& summary);
 
 // JSON with exactly the keys success_rate, time_s, energy_J, F, configurations,
 // terminations, episodes, first_modules, shed_after_stairs; NaN is written as

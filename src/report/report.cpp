@@ -189,7 +189,18 @@ ReportBlock comparison_table(const PaperTable& paper, const std::vector<RunDir>&
   row("Time (s)", [](const EvalSummary& m) { return m.time_s; }, 1, [](const PaperColumn& p) { return p.time_s; });
   row("Battery (J)", [](const EvalSummary& m) { return m.energy_J; }, 0,
       [](const PaperColumn& p) { return p.energy_J; });
-  for (const std::string key : {"0.04", "0.06", "0.08", "avg"}) {
+  // The paper's stair heights (the table compares ours at the same heights), then the average.
+  std::vector<std::pair<double, std::string>> heights;
+  for (const auto& column : paper.columns)
+    for (const auto& [key, percent] : column.success_percent)
+      if (key != "avg" && std::find_if(heights.begin(), heights.end(), [&](const auto& h) { return h.second == key; }) ==
+                              heights.end())
+        heights.emplace_back(std::stod(key), key);
+  std::sort(heights.begin(), heights.end());
+  std::vector<std::string> keys;
+  for (const auto& [height, key] : heights) keys.push_back(key);
+  keys.push_back("avg");
+  for (const std::string& key : keys) {
     const std::string name = key == "avg" ? "Success avg (%)" : fmt::format("Success {} m (%)", key);
     row(name, [key](const EvalSummary& m) { return 100.0 * lookup(m.success_rate, key); }, 1,
         [key](const PaperColumn& p) { return lookup(p.success_percent, key); });
@@ -272,14 +283,11 @@ std::string render_html(const std::vector<ReportBlock>& blocks, const std::strin
   return out + "</body>\n</html>\n";
 }
 
-ReportResult write_report(const std::vector<std::string>& run_dirs, const ReportOptions& options) {
-  if (run_dirs.empty()) throw std::invalid_argument("report: no run directories given");
-  if (options.out_dir.empty()) throw std::invalid_argument("report: no output directory given");
-  const std::string ref_path = options.reference_path.empty() ? default_paper_reference_path() : options.reference_path;
-  const PaperReference paper = load_paper_reference(ref_path);
-  std::vector<RunDir> runs;
-  for (const auto& d : run_dirs) runs.push_back(load_run_dir(d));
-  fs::create_directories(options.out_dir);
+namespace {
+
+ReportResult write_report_files(const std::vector<RunDir>& runs, const std::vector<CurveSeries>& series,
+                                const PaperReference& paper, const std::string& ref_path,
+                                const ReportOptions& options) {
   const fs::path out(options.out_dir);
   ReportResult result;
 
@@ -289,7 +297,7 @@ ReportResult write_report(const std::vector<std::string>& run_dirs, const Report
       "Runs: {}. {} The paper: {}; numbers from {}. "
       "Time and Battery average the successful evaluation episodes only; success is counted per stair "
       "height and averaged over the heights.",
-      run_dirs.size(), comparison_table_legend(), paper.source, ref_path)));
+      runs.size(), comparison_table_legend(), paper.source, ref_path)));
   if (!paper.protocol.empty()) doc.push_back(paragraph("Paper protocol: " + paper.protocol));
 
   for (const auto& t : paper.tables) {
@@ -302,8 +310,6 @@ ReportResult write_report(const std::vector<std::string>& run_dirs, const Report
 
   // Training curves, all runs in one figure as in Fig. 9.
   doc.push_back(heading(2, "Training curves"));
-  std::vector<CurveSeries> series;
-  for (const auto& r : runs) series.push_back({r.info.name, read_episodes_csv(r.episodes_csv)});
   const bool have_gnuplot = !find_executable("gnuplot").empty();
   if (have_gnuplot || options.require_plots) {
     CurveOptions curve;
@@ -326,18 +332,28 @@ ReportResult write_report(const std::vector<std::string>& run_dirs, const Report
     doc.push_back(heading(3, r.info.name));
     doc.push_back(paragraph(fmt::format("{}: {}.{}", r.path, describe(r.info),
                                         r.info.notes.empty() ? "" : " " + r.info.notes)));
+    // A success column per stair height any of the run's evaluations had.
+    std::vector<std::pair<double, std::string>> heights;
+    for (const auto& [scenario, m] : r.evals)
+      for (const std::string& key : stair_keys(m)) heights.emplace_back(std::stod(key), key);
+    std::sort(heights.begin(), heights.end());
+    heights.erase(std::unique(heights.begin(), heights.end()), heights.end());
+    std::vector<std::string> header{"Evaluation", "Episodes"};
+    for (const auto& [height, key] : heights) header.push_back(fmt::format("Success {} m (%)", key));
+    for (const char* name : {"Success avg (%)", "Time (s)", "Battery (J)", "F(H)", "Terminations (episodes)"})
+      header.push_back(name);
     std::vector<std::vector<std::string>> rows;
     for (const auto& [scenario, m] : r.evals) {
       std::vector<std::string> terms;
       for (const auto& [why, n] : m.terminations) terms.push_back(fmt::format("{}: {}", why, n));
-      rows.push_back({scenario, std::to_string(m.episodes), percent(lookup(m.success_rate, "0.04")),
-                      percent(lookup(m.success_rate, "0.06")), percent(lookup(m.success_rate, "0.08")),
-                      percent(lookup(m.success_rate, "avg")), num(m.time_s, 1), num(m.energy_J, 0), num(m.F, 3),
-                      fmt::format("{}", fmt::join(terms, ", "))});
+      std::vector<std::string> row{scenario, std::to_string(m.episodes)};
+      for (const auto& [height, key] : heights) row.push_back(percent(lookup(m.success_rate, key)));
+      for (const std::string& cell : {percent(lookup(m.success_rate, "avg")), num(m.time_s, 1), num(m.energy_J, 0),
+                                      num(m.F, 3), fmt::format("{}", fmt::join(terms, ", "))})
+        row.push_back(cell);
+      rows.push_back(std::move(row));
     }
-    doc.push_back(table({"Evaluation", "Episodes", "Success 0.04 m (%)", "Success 0.06 m (%)", "Success 0.08 m (%)",
-                         "Success avg (%)", "Time (s)", "Battery (J)", "F(H)", "Terminations (episodes)"},
-                        std::move(rows)));
+    doc.push_back(table(std::move(header), std::move(rows)));
 
     // Chosen configurations per stair height, with the paper's where it gives them.
     std::map<std::string, std::string> paper_choice;
@@ -376,6 +392,29 @@ ReportResult write_report(const std::vector<std::string>& run_dirs, const Report
   write_file_atomic(result.html_path, render_html(doc, "comorph report"));
   spdlog::info("report: {} and {} ({} images)", result.markdown_path, result.html_path, result.images.size());
   return result;
+}
+
+}  // namespace
+
+ReportResult write_report(const std::vector<std::string>& run_dirs, const ReportOptions& options) {
+  if (run_dirs.empty()) throw std::invalid_argument("report: no run directories given");
+  if (options.out_dir.empty()) throw std::invalid_argument("report: no output directory given");
+  const std::string ref_path = options.reference_path.empty() ? default_paper_reference_path() : options.reference_path;
+  const PaperReference paper = load_paper_reference(ref_path);
+  // Everything is read before anything is written: a damaged input leaves no output behind.
+  std::vector<RunDir> runs;
+  for (const auto& d : run_dirs) runs.push_back(load_run_dir(d));
+  std::vector<CurveSeries> series;
+  for (const auto& r : runs) series.push_back({r.info.name, read_episodes_csv(r.episodes_csv)});
+  const bool created = !fs::exists(options.out_dir);
+  fs::create_directories(options.out_dir);
+  try {
+    return write_report_files(runs, series, paper, ref_path, options);
+  } catch (...) {
+    std::error_code ignored;
+    if (created) fs::remove_all(options.out_dir, ignored);
+    throw;
+  }
 }
 
 }  // namespace comorph::report

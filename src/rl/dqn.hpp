@@ -41,7 +41,6 @@ class Dqn final : public OffPolicyLearner {
   // Q values of one observation (greedy diagnostics, tests).
   std::vector<float> q_values(const Observation& observation);
   const DqnConfig& config() const { return config_; }
-  QNetwork& q_network() { return q_; }
   QNetwork& target_network() { return q_target_; }
 
  protected:

@@ -11,19 +11,18 @@ namespace {
 
 // A LinearSchedule's fields <prefix>_start and _end in [0, max], _decay in steps.
 void add_linear_schedule(YamlFields& f, const std::string& prefix, double& start, double& end, double& decay,
-                         double max) {
-  f.add(prefix + "_start", &start, 0.0, max);
-  f.add(prefix + "_end", &end, 0.0, max);
-  f.add(prefix + "_decay", &decay, 0.0, 1e12);
+                         double max, const std::string& what, const std::string& unit) {
+  f.add(prefix + "_start", &start, 0.0, max, what + " at the start");
+  f.add(prefix + "_end", &end, 0.0, max, what + " after the decay");
+  f.add(prefix + "_decay", &decay, 0.0, 1e12, unit + " to decay over, linearly; 0 = constant " + prefix + "_end");
 }
 
-// The shared fields, the learner's own (add_own), then the shared checks.
-template <class Config, class AddOwn>
-Config read_learner_config(const YAML::Node& node, const std::string& source, AddOwn add_own) {
+// The learner's fields, read from `node`, then the shared checks.
+template <class Config>
+Config read_learner_config(const YAML::Node& node, const std::string& source) {
   Config c;
   YamlFields f(source);
-  add_shared_learner_fields(f, c);
-  add_own(f, c);
+  add_fields(f, c);
   f.apply(node);
   check_shared_learner_fields(f, c);
   return c;
@@ -31,46 +30,66 @@ Config read_learner_config(const YAML::Node& node, const std::string& source, Ad
 
 }  // namespace
 
+void add_fields(YamlFields& f, DqnConfig& c) {
+  add_shared_learner_fields(f, c);
+  f.add("discount_per", &c.discount_per,
+        "what gamma discounts: step (gamma^k over a transition's k env steps) | decision (once per transition, "
+        "the paper's Algorithm 1)");
+  f.add("learning_rate", &c.learning_rate, kMinPositive, 1.0, "Adam step size");
+  f.add("adam_epsilon", &c.adam_epsilon, 1e-20, 1.0, "Adam's epsilon");
+  f.add("target_update_interval", &c.target_update_interval, 1, 1000000000, "updates between target syncs");
+  add_linear_schedule(f, "epsilon", c.epsilon_start, c.epsilon_end, c.epsilon_decay, 1.0,
+                      "probability of a random choice", "stored transitions");
+  f.add("loss", &c.loss, "loss on the TD error: huber (smooth L1, delta 1) or mse (squared)");
+  f.add("double_dqn", &c.double_dqn, "pick the next action with the online network (double DQN)");
+}
+
+void add_fields(YamlFields& f, Td3Config& c) {
+  add_shared_learner_fields(f, c);
+  add_actor_critic_fields(f, c);
+  f.add("policy_delay", &c.policy_delay, 1, 1000000, "critic updates per actor and target update (d)");
+  f.add("policy_noise", &c.policy_noise, 0.0, 10.0, "std of the target smoothing noise, action units");
+  f.add("noise_clip", &c.noise_clip, 0.0, 10.0, "clip of the target smoothing noise");
+  add_linear_schedule(f, "exploration_noise", c.exploration_noise_start, c.exploration_noise_end,
+                      c.exploration_noise_decay, 10.0, "std of the exploration noise, action units",
+                      "transitions or episodes (exploration_noise_unit)");
+  f.add("exploration_noise_unit", &c.exploration_noise_unit, "what exploration_noise_decay counts");
+  f.add("exploration_noise_correlation", &c.exploration_noise_correlation, 0.0, 0.9999,
+        "correlation of the exploration noise between steps: 0 = white, > 0 AR(1) forgetting over -1/ln(rho) steps");
+  f.add("bc_weight", &c.bc_weight, 0.0, 1000.0,
+        "weight of behaviour cloning towards the transitions' target actions (TD3+BC); 0 = plain TD3");
+  f.add("bc_decay_updates", &c.bc_decay_updates, std::int64_t(0), std::int64_t(1) << 40,
+        "actor updates over which bc_weight falls linearly to 0; 0 = constant");
+  f.add("actor_q_weight", &c.actor_q_weight, 0.0, 1.0,
+        "weight of the Q term in the actor loss: 1 = TD3 (+BC), 0 = imitation of the targets alone");
+}
+
+void add_fields(YamlFields& f, SacConfig& c) {
+  add_shared_learner_fields(f, c);
+  add_actor_critic_fields(f, c);
+  f.add("alpha_learning_rate", &c.alpha_learning_rate, kMinPositive, 1.0, "Adam step size of log(alpha)");
+  f.add("policy_frequency", &c.policy_frequency, 1, 1000000,
+        "critic updates between actor rounds (each of this many steps)");
+  f.add("target_network_frequency", &c.target_network_frequency, 1, 1000000,
+        "critic updates between soft target updates");
+  f.add("alpha", &c.alpha, kMinPositive, 1000.0, "entropy temperature (the initial value when autotuned)");
+  f.add("autotune_alpha", &c.autotune_alpha, "learn alpha towards the target entropy");
+  f.add("target_entropy_scale", &c.target_entropy_scale, -100.0, 100.0,
+        "target entropy = -scale * action dimensions, nats");
+  f.add("log_std_min", &c.log_std_min, -20.0, 10.0, "lower bound of the actor's log std");
+  f.add("log_std_max", &c.log_std_max, -20.0, 10.0, "upper bound of the actor's log std");
+}
+
 DqnConfig DqnConfig::from_yaml(const YAML::Node& node, const std::string& source) {
-  return read_learner_config<DqnConfig>(node, source, [](YamlFields& f, DqnConfig& c) {
-    f.add("learning_rate", &c.learning_rate, kMinPositive, 1.0);
-    f.add("adam_epsilon", &c.adam_epsilon, 1e-20, 1.0);
-    f.add("target_update_interval", &c.target_update_interval, 1, 1000000000);
-    add_linear_schedule(f, "epsilon", c.epsilon_start, c.epsilon_end, c.epsilon_decay, 1.0);
-    f.add("loss", &c.loss);
-    f.add("double_dqn", &c.double_dqn);
-    f.add("discount_per", &c.discount_per);
-  });
+  return read_learner_config<DqnConfig>(node, source);
 }
 
 Td3Config Td3Config::from_yaml(const YAML::Node& node, const std::string& source) {
-  return read_learner_config<Td3Config>(node, source, [](YamlFields& f, Td3Config& c) {
-    add_actor_critic_fields(f, c);
-    f.add("policy_delay", &c.policy_delay, 1, 1000000);
-    f.add("policy_noise", &c.policy_noise, 0.0, 10.0);
-    f.add("noise_clip", &c.noise_clip, 0.0, 10.0);
-    add_linear_schedule(f, "exploration_noise", c.exploration_noise_start, c.exploration_noise_end,
-                        c.exploration_noise_decay, 10.0);
-    f.add("exploration_noise_unit", &c.exploration_noise_unit);
-    f.add("exploration_noise_correlation", &c.exploration_noise_correlation, 0.0, 0.9999);
-    f.add("bc_weight", &c.bc_weight, 0.0, 1000.0);
-    f.add("bc_decay_updates", &c.bc_decay_updates, std::int64_t(0), std::int64_t(1) << 40);
-    f.add("actor_q_weight", &c.actor_q_weight, 0.0, 1.0);
-  });
+  return read_learner_config<Td3Config>(node, source);
 }
 
 SacConfig SacConfig::from_yaml(const YAML::Node& node, const std::string& source) {
-  const SacConfig c = read_learner_config<SacConfig>(node, source, [](YamlFields& f, SacConfig& c) {
-    add_actor_critic_fields(f, c);
-    f.add("alpha_learning_rate", &c.alpha_learning_rate, kMinPositive, 1.0);
-    f.add("policy_frequency", &c.policy_frequency, 1, 1000000);
-    f.add("target_network_frequency", &c.target_network_frequency, 1, 1000000);
-    f.add("alpha", &c.alpha, kMinPositive, 1000.0);
-    f.add("autotune_alpha", &c.autotune_alpha);
-    f.add("target_entropy_scale", &c.target_entropy_scale, -100.0, 100.0);
-    f.add("log_std_min", &c.log_std_min, -20.0, 10.0);
-    f.add("log_std_max", &c.log_std_max, -20.0, 10.0);
-  });
+  const SacConfig c = read_learner_config<SacConfig>(node, source);
   if (!(c.log_std_min < c.log_std_max)) YamlFields(source).fail("log_std_max", "must be above log_std_min");
   return c;
 }

@@ -29,29 +29,32 @@ inline constexpr std::int64_t kMaxSteps = 1000000000000;
 // from_yaml adds its own fields next to these.
 template <class LearnerConfig>
 void add_shared_learner_fields(YamlFields& f, LearnerConfig& c) {
-  f.add("gamma", &c.gamma, 0.0, 1.0);
-  f.add("batch_size", &c.batch_size, 1, 1000000);
-  f.add("buffer_size", &c.buffer_size, 1, 1000000000);
-  f.add("learning_starts", &c.learning_starts, 0, kMaxSteps);
-  f.add("train_frequency", &c.train_frequency, 1, 1000000000);
-  f.add("gradient_steps", &c.gradient_steps, 1, 1000000);
-  f.add("tau", &c.tau, 0.0, 1.0);
-  f.add("max_grad_norm", &c.max_grad_norm, 0.0, 1e9);
-  f.add("hidden_sizes", &c.hidden_sizes);
-  f.add("image_features", &c.image_features, 1, 65536);
-  f.add("image_fc_size", &c.image_fc_size, 1, 65536);
-  f.add("image_storage", &c.image_storage);
-  f.add("device", &c.device);
+  f.add("gamma", &c.gamma, 0.0, 1.0, "discount factor");
+  f.add("batch_size", &c.batch_size, 1, 1000000, "transitions per update");
+  f.add("buffer_size", &c.buffer_size, 1, 1000000000, "replay capacity, transitions");
+  f.add("learning_starts", &c.learning_starts, 0, kMaxSteps, "transitions stored before the first update");
+  f.add("train_frequency", &c.train_frequency, 1, 1000000000, "stored transitions between update rounds");
+  f.add("gradient_steps", &c.gradient_steps, 1, 1000000, "updates per round");
+  f.add("tau", &c.tau, 0.0, 1.0, "target network update: 1 = copy, < 1 = Polyak weight");
+  f.add("max_grad_norm", &c.max_grad_norm, 0.0, 1e9, "clip of the gradients' L2 norm; 0 = off");
+  f.add("hidden_sizes", &c.hidden_sizes, "widths of the MLP's hidden layers");
+  f.add("image_features", &c.image_features, 1, 65536, "the image encoder's output size");
+  f.add("image_fc_size", &c.image_fc_size, 1, 65536, "the image encoder's hidden fully connected layer");
+  f.add("image_storage", &c.image_storage, "how the replay keeps images (value * 255 rounded, or float16)");
+  f.add("device", &c.device, "torch device of networks and batches (cpu, cuda, cuda:N)");
 }
 
 // The fields TD3 and SAC (actor-critic learners) share, with their ranges.
 template <class ActorCriticConfig>
 void add_actor_critic_fields(YamlFields& f, ActorCriticConfig& c) {
-  f.add("actor_learning_rate", &c.actor_learning_rate, kMinPositive, 1.0);
-  f.add("critic_learning_rate", &c.critic_learning_rate, kMinPositive, 1.0);
-  f.add("random_action_steps", &c.random_action_steps, 0, kMaxSteps);
-  f.add("random_action_episodes", &c.random_action_episodes, 0, kMaxSteps);
-  f.add("share_encoder", &c.share_encoder);
+  f.add("actor_learning_rate", &c.actor_learning_rate, kMinPositive, 1.0, "Adam step size of the actor");
+  f.add("critic_learning_rate", &c.critic_learning_rate, kMinPositive, 1.0,
+        "Adam step size of the critics (and the encoder)");
+  f.add("random_action_steps", &c.random_action_steps, 0, kMaxSteps,
+        "uniform random actions for this many transitions (a run's warm-up is trainer.warmup_episodes)");
+  f.add("random_action_episodes", &c.random_action_episodes, 0, kMaxSteps,
+        "... and for this many episodes (the classic loop; a run needs 0)");
+  f.add("share_encoder", &c.share_encoder, "the actor uses the critic encoder's features (detached)");
 }
 
 // What the ranges of add_shared_learner_fields cannot say: layer widths
@@ -191,5 +194,11 @@ struct SacConfig : ActorCriticNetworkConfig {
 
   static SacConfig from_yaml(const YAML::Node& node, const std::string& source);
 };
+
+// Every field of a learner's config with its range and meaning: what
+// from_yaml reads, `comorph config keys` lists and a run's config.yaml holds.
+void add_fields(YamlFields& f, DqnConfig& c);
+void add_fields(YamlFields& f, Td3Config& c);
+void add_fields(YamlFields& f, SacConfig& c);
 
 }  // namespace comorph::rl

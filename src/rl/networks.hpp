@@ -61,7 +61,6 @@ class ObservationEncoderImpl : public torch::nn::Module {
   // spec has none.
   torch::Tensor forward(const torch::Tensor& image, const torch::Tensor& vector);
   int output_size() const { return output_size_; }
-  bool has_cnn() const { return !cnn_.is_empty(); }
   double forward_flops() const;
 
  private:

@@ -17,6 +17,8 @@ template <class Config, class L>
 LearnerEntry builtin(const std::string& name, ActionKind actions) {
   LearnerEntry e;
   e.actions = actions;
+  e.default_config = [] { return std::any(Config{}); };
+  e.add_fields = [](YamlFields& fields, std::any& config) { add_fields(fields, std::any_cast<Config&>(config)); };
   e.read_config = [](const YAML::Node& node, const std::string& source) {
     return std::any(Config::from_yaml(node, source));
   };
@@ -53,7 +55,13 @@ const LearnerEntry& checked(const std::string& name, const LearnerArgs& args) {
 
 }  // namespace
 
-void register_learner(const std::string& name, LearnerEntry entry) { registry()[name] = std::move(entry); }
+void register_learner(const std::string& name, LearnerEntry entry) {
+  if (!entry.default_config || !entry.add_fields || !entry.read_config || !entry.make_learner || !entry.make_policy)
+    throw std::invalid_argument("register_learner " + name +
+                                ": every function of the entry must be set (default_config, add_fields, read_config, "
+                                "make_learner, make_policy)");
+  registry()[name] = std::move(entry);
+}
 
 bool has_learner(const std::string& name) { return registry().count(name) > 0; }
 

@@ -1,6 +1,7 @@
 // Learners by name. Each entry says what the algorithm learns from (its
-// action kind, on- or off-policy), how its hyperparameters are read, and
-// builds its Learner and its acting Policy. The classic loop (`comorph
+// action kind, on- or off-policy), declares its hyperparameters (a run's
+// config has a section of the learner's name: `comorph config keys` lists
+// it), and builds its Learner and its acting Policy. The classic loop (`comorph
 // classic`) and the hierarchical trainer build learners only through it, so a
 // new algorithm registers itself and needs no edit of either. DQN, TD3 and SAC
 // are registered from the start.
@@ -16,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "common/yaml_fields.hpp"
 #include "rl/env.hpp"
 #include "rl/learner.hpp"
 #include "rl/policy.hpp"
@@ -41,13 +43,20 @@ struct LearnerEntry {
   // keeps no replay segments for it (Learner::replay is not used) and
   // checkpoints it whole with save().
   bool on_policy = false;
+  // Its typed config with the defaults, and the fields of such a config
+  // (YamlFields::add with ranges and meanings): what read_config reads, what
+  // `comorph config keys` lists and what a run's config.yaml holds.
+  std::function<std::any()> default_config;
+  std::function<void(YamlFields& fields, std::any& config)> add_fields;
+  // The fields' values from `node` over the defaults, checked (throws naming `source`).
   std::function<std::any(const YAML::Node& node, const std::string& source)> read_config;
   std::function<std::unique_ptr<Learner>(const LearnerArgs&)> make_learner;
   std::function<std::unique_ptr<Policy>(const LearnerArgs&)> make_policy;
 };
 
-// Adds (or replaces) the entry `name`. Register before building learners;
-// the registry is not locked against concurrent registration.
+// Adds (or replaces) the entry `name`; throws std::invalid_argument when one
+// of its functions is not set. Register before building learners; the
+// registry is not locked against concurrent registration.
 void register_learner(const std::string& name, LearnerEntry entry);
 bool has_learner(const std::string& name);
 // Throws std::invalid_argument naming the registered learners when `name` is not one.

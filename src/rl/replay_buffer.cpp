@@ -257,13 +257,8 @@ void ReplayBuffer::load(torch::serialize::InputArchive& a) {
   restore("reward", reward_);
   restore("discount", discount_);
   restore("terminated", terminated_);
-  // Buffers saved before behaviour-cloning targets existed have none.
-  has_target_.zero_();
-  torch::Tensor saved;
-  if (a.try_read("has_target", saved)) {
-    restore("has_target", has_target_);
-    if (target_.defined()) restore("target", target_);
-  }
+  restore("has_target", has_target_);
+  if (target_.defined()) restore("target", target_);
   if (next_valid_.defined()) restore("next_valid", next_valid_);
 }
 

@@ -100,7 +100,7 @@ ReplaySegments write_replay_segments(const ReplayBuffer& buffer, const std::stri
 ReplaySegments read_replay_segments(ReplayBuffer& buffer, const std::string& name, const std::string& dir) {
   ReplaySegments s;
   const std::string index = (fs::path(dir) / replay_index_name(name)).string();
-  if (!fs::exists(index)) return s;
+  if (!fs::exists(index)) throw std::runtime_error(index + ": missing (the checkpoint is incomplete)");
   try {
     const YAML::Node n = load_yaml_file(index);
     s.capacity = n["capacity"].as<std::int64_t>();

@@ -54,10 +54,8 @@ ReplaySegments write_replay_segments(const ReplayBuffer& buffer, const std::stri
                                      std::map<std::string, std::string>& sums);
 
 // Reads dir/<name>-replay.yaml and its segments into `buffer` and returns
-// their state; without that index (a checkpoint from before segments, whose
-// learner file holds the buffer) returns an empty state and leaves `buffer`
-// alone. Throws naming the file when the index does not fit the buffer or
-// does not cover every transition it counts.
+// their state. Throws naming the file when the index is missing, does not fit
+// the buffer or does not cover every transition it counts.
 ReplaySegments read_replay_segments(ReplayBuffer& buffer, const std::string& name, const std::string& dir);
 
 }  // namespace comorph::rl

@@ -32,8 +32,4 @@ enum ModuleActuator : int { kWheelLeft = 0, kWheelRight = 1, kFrontHinge = 2, kB
 std::string build_mjcf(const Configuration& config, const RobotParams& robot, const SceneParams& scene,
                        const SceneLayout& layout);
 
-// qpos index of the first joint of module k (0-based) after the 7 root coordinates.
-inline int module_qpos(int k) { return 7 + kJointsPerModule * k; }
-inline int module_qvel(int k) { return 6 + kJointsPerModule * k; }
-
 }  // namespace comorph::sim

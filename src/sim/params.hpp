@@ -3,7 +3,12 @@
 // mirrored in configs/robot.yaml and configs/scene.yaml.
 #pragma once
 
+#include <array>
 #include <string>
+
+namespace comorph {
+class YamlFields;
+}
 
 namespace comorph::sim {
 
@@ -102,7 +107,19 @@ struct SceneParams {
   double start_lateral_noise = 0.05;  // m, seeded start offset in y
   double start_yaw_noise = 0.05;      // rad, seeded start heading noise
   double target_zone_distance = 1.5;  // m, scene label 2 within this of the target
+
+  // The heights an episode draws from (one of the three, uniformly; they may repeat).
+  std::array<double, 3> stair_heights() const { return {stair_height_a, stair_height_b, stair_height_c}; }
 };
+
+// Every field of RobotParams / SceneParams with its range and meaning (for
+// reading, `comorph config keys` and a run's resolved config).
+void add_fields(YamlFields& f, RobotParams& p);
+void add_fields(YamlFields& f, SceneParams& p);
+// What the ranges cannot say (a control period that is a multiple of the
+// time step, ...); throws through f.fail.
+void check_fields(const YamlFields& f, const RobotParams& p);
+void check_fields(const YamlFields& f, const SceneParams& p);
 
 // Loads a YAML file of fields of RobotParams / SceneParams. Missing fields keep
 // their defaults; unknown fields and out-of-range values throw

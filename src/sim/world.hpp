@@ -85,8 +85,6 @@ class World {
   const mjData* data() const { return data_; }
   mjData* mutable_data() { return data_; }  // for tests and tools; not for the env hot path
   const SceneLayout& layout() const { return layout_; }
-  const RobotParams& robot_params() const { return robot_; }
-  const SceneParams& scene_params() const { return scene_; }
   double time() const { return data_->time; }
   // Module k (0-based): body position (m) and rotation matrix (row-major 3x3).
   const double* module_pos(int k) const { return data_->xpos + 3 * module_body_[k]; }

@@ -8,6 +8,10 @@
 #include "sim/params.hpp"
 #include "task/rewards.hpp"
 
+namespace comorph {
+class YamlFields;
+}
+
 namespace comorph::task {
 
 struct TaskParams {
@@ -36,6 +40,8 @@ EnvConfig load_env_config(const std::string& dir);
 // absent file says so). Part of a run's identity: a resume compares it, so an
 // edited robot.yaml cannot change a run's physics halfway.
 std::string env_files_text(const std::string& dir);
+// Every field of TaskParams with its range and meaning.
+void add_fields(YamlFields& f, TaskParams& p);
 TaskParams task_params_from_yaml(const std::string& text, const std::string& source_name,
                                  TaskParams defaults = {});
 

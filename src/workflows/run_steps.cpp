@@ -145,7 +145,7 @@ report::EvalSummary eval_run(const std::string& run_dir, const std::string& scen
 
   std::vector<comorph::report::EpisodeRecord> records;
   for (const auto& l : logs) records.push_back(to_record(l));
-  const auto m = comorph::report::summarize(records, f_weights(config));
+  const auto m = comorph::report::summarize(records, f_weights(config), comorph::coopt::stair_heights(config));
   const std::string name =
       "eval-" + scenario + (forced_modules > 0 ? "-modules" + std::to_string(forced_modules) : std::string()) +
       (pilot_drives ? "-pilot" : "");
@@ -160,7 +160,7 @@ report::EvalSummary eval_run(const std::string& run_dir, const std::string& scen
                (pilot_drives ? ", driven by the scripted pilot" : ""))
                   .c_str());
   std::printf("%-8s %-9s %s\n", "stairs", "success", "configurations (episodes)");
-  for (const std::string& key : comorph::report::paper_stair_keys()) {
+  for (const std::string& key : comorph::report::stair_keys(m)) {
     std::string seqs;
     if (m.configurations.count(key))
       for (const auto& [seq, n] : m.configurations.at(key)) seqs += (seqs.empty() ? "" : ", ") + seq + " x" + std::to_string(n);
@@ -168,7 +168,7 @@ report::EvalSummary eval_run(const std::string& run_dir, const std::string& scen
   }
   std::printf("%-8s %-9s\n", "avg", format_rate(m.success_rate.at("avg")).c_str());
   std::string first;
-  for (const std::string& key : comorph::report::paper_stair_keys())
+  for (const std::string& key : comorph::report::stair_keys(m))
     if (m.first_modules.count(key) && !std::isnan(m.first_modules.at(key)))
       first += fmt::format("{}{:.2f} at {} m", first.empty() ? "" : ", ", m.first_modules.at(key), key);
   if (!first.empty())
@@ -184,7 +184,7 @@ report::EvalSummary eval_run(const std::string& run_dir, const std::string& scen
   // What the first decision is paid, per stair height: the quantities its
   // choice trades (R2 = summed R1 + the climb reward - sigma3 x stair energy).
   std::printf("first segment (to the first declared switch), means per stair height:\n");
-  for (const std::string& key : comorph::report::paper_stair_keys()) {
+  for (const std::string& key : comorph::report::stair_keys(m)) {
     double r2 = 0, r1 = 0, steps = 0, stairs_J = 0;
     int n = 0;
     for (const auto& l : logs)

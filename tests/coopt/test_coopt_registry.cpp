@@ -123,14 +123,35 @@ TEST(Registry, AnOnPolicyLearnerRegisteredOutsideTrainsThroughTheTrainer) {
   rl::LearnerEntry e;
   e.actions = rl::ActionKind::kContinuous;
   e.on_policy = true;
-  e.read_config = [](const YAML::Node&, const std::string&) { return std::any(); };
+  // One setting, so that its section shows in `config keys` and in the run's config.yaml.
+  e.default_config = [] { return std::any(0.5); };
+  e.add_fields = [](YamlFields& f, std::any& config) {
+    f.add("clip", &std::any_cast<double&>(config), 0.0, 1.0, "the stub's clip ratio");
+  };
+  e.read_config = [e](const YAML::Node& node, const std::string& source) {
+    std::any config = e.default_config();
+    YamlFields f(source);
+    e.add_fields(f, config);
+    f.apply(node);
+    return config;
+  };
   e.make_learner = [](const rl::LearnerArgs& a) { return std::make_unique<PpoStub>(a); };
   e.make_policy = [](const rl::LearnerArgs& a) { return std::make_unique<PpoStubPolicy>(a); };
   rl::register_learner("ppo_stub", e);
 
   const std::string dir = test_support::fresh_temp_dir("coopt_ppo_stub");
   const coopt::CooptConfig c = coopt::load_coopt_config(std::string(COMORPH_SOURCE_DIR) + "/configs/ci.yaml",
-                                                        {"trainer.motion_algo=ppo_stub"});
+                                                        {"trainer.motion_algo=ppo_stub", "ppo_stub.clip=0.2"});
+  // The registry gives the learner its section: read, resolved into the run's config, listed.
+  EXPECT_EQ(std::any_cast<double>(c.other_learners.at("ppo_stub")), 0.2);
+  EXPECT_NE(c.text.find("ppo_stub:\n  clip: 0.2"), std::string::npos) << c.text;
+  bool listed = false;
+  for (const auto& section : coopt::settings_sections(c)) listed = listed || section.name == "ppo_stub";
+  EXPECT_TRUE(listed);
+  EXPECT_NE(test_support::error_of([] {
+              coopt::load_coopt_config(std::string(COMORPH_SOURCE_DIR) + "/configs/ci.yaml", {"ppo_stub.clip=2"});
+            }).find("ppo_stub: field 'clip': value 2 out of range [0, 1]"),
+            std::string::npos);
   int episodes = 0;
   coopt::TrainerCallbacks cb;
   cb.on_episode = [&episodes](const coopt::EpisodeLog& l) {

@@ -69,6 +69,12 @@ TEST(Checkpoint, CarriesChecksumsAndKeepsThePreviousOne) {
   EXPECT_EQ(verify_checksums(dir + "/checkpoint"), "");
   EXPECT_EQ(verify_checksums(dir + "/checkpoint.old"), "");
   EXPECT_EQ(read_checkpoint_info(dir).episodes, 4);
+  // A checkpoint whose checksum file was deleted is not verified, so not used.
+  fs::remove(dir + "/checkpoint/" + kChecksumFile);
+  EXPECT_EQ(read_checkpoint_info(dir).directory, dir + "/checkpoint.old");
+  fs::remove(dir + "/checkpoint.old/" + kChecksumFile);
+  const std::string e = error_of([&] { read_checkpoint_info(dir); });
+  EXPECT_NE(e.find(dir + "/checkpoint/checksums.txt: missing"), std::string::npos) << e;
   fs::remove_all(dir);
 }
 

@@ -690,6 +690,33 @@ TEST(Cli, TrainThenEvalWritesTheRunDirectoryLayout) {
   fs::remove_all(parent);
 }
 
+// The stair heights are the run's (env.scene), not the paper's three: a run
+// with 0.05 and 0.1 m stairs trains, evaluates and reports both.
+TEST(Cli, AConfigsOwnStairHeightsAreReportedEverywhere) {
+  const std::string parent = temp_dir("cli_heights");
+  const std::string out = parent + "/run";
+  const std::string heights =
+      " --set env.scene.stair_height_a=0.05 --set env.scene.stair_height_b=0.1 --set env.scene.stair_height_c=0.1";
+  std::string log;
+  ASSERT_EQ(run_cli("train --config " + kCi + heights + " --set trainer.episodes=3 --out " + out, log), 0) << log;
+  EXPECT_NE(log.find("success 0.05/0.1 m = "), std::string::npos) << log;  // the periodic evaluation's line
+  const std::string evaluations = test_support::read_text(out + "/evaluations.csv");
+  EXPECT_EQ(evaluations.rfind("train_episode,env_steps,wall_s,episodes,success_0.05,success_0.1,success_avg,", 0), 0u)
+      << evaluations;
+  EXPECT_EQ(evaluations.find(",-,"), std::string::npos) << evaluations;  // both heights were evaluated
+  ASSERT_EQ(run_cli("eval --run " + out + " --episodes 3", log), 0) << log;
+  EXPECT_NE(log.find("0.05 m"), std::string::npos) << log;
+  EXPECT_NE(log.find("0.1 m"), std::string::npos) << log;
+  const std::string json = test_support::read_text(out + "/eval-default.json");
+  for (const char* key : {"\"0.05\"", "\"0.1\""}) EXPECT_NE(json.find(key), std::string::npos) << key << json;
+  EXPECT_EQ(json.find("\"0.04\""), std::string::npos) << json;
+  ASSERT_EQ(run_cli("report " + out + " --out " + parent + "/report", log), 0) << log;
+  const std::string report = test_support::read_text(parent + "/report/report.md");
+  for (const char* column : {"Success 0.05 m (%)", "Success 0.1 m (%)"})
+    EXPECT_NE(report.find(column), std::string::npos) << column;
+  fs::remove_all(parent);
+}
+
 }  // namespace
 }  // namespace comorph::coopt
 

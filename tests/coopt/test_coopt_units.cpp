@@ -1,10 +1,15 @@
-// Candidate masks, R2 over a segment, and the run config (keys, ranges, --set).
+// Candidate masks, R2 over a segment, and the run config (keys, ranges, --set,
+// presets that build on others, the resolved config, the settings' list).
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "coopt/config.hpp"
+#include "coopt/config_reference.hpp"
 #include "coopt/segment.hpp"
+#include "support/test_support.hpp"
 #include "task/rewards.hpp"
 
 namespace comorph::coopt {
@@ -91,8 +96,91 @@ TEST(CooptConfig, CiPresetLoadsAndSetOverridesNestedKeys) {
   EXPECT_EQ(c.td3.hidden_sizes, (std::vector<int>{8, 8}));
   EXPECT_NE(c.text.find("episodes: 7"), std::string::npos);
   EXPECT_EQ(c.preset, "ci");
-  // The merged text reloads to the same config (what resume relies on).
+  // The resolved text reloads to the same config (what resume relies on).
   EXPECT_EQ(coopt_config_from_text(c.text, "copy").text, c.text);
+}
+
+// A run's config holds every setting, defaults included, and only the
+// sections the run uses; an input that resolves to the same settings is the
+// same run, whatever it spells out.
+TEST(CooptConfig, TheResolvedConfigHoldsEveryDefaultAndIsTheRunsIdentity) {
+  const CooptConfig c = load_coopt_config(kCi);
+  for (const char* key : {"trainer:\n  mode: hierarchical", "  pilot_labels: false", "env:\n  robot:\n    module_length: 0.16",
+                          "    stair_height_c: 0.08", "perception:\n  classifier:", "td3:\n  gamma: 0.99",
+                          "  actor_q_weight: 1", "dqn:\n", "eval:\n  episodes: 6"})
+    EXPECT_NE(c.text.find(key), std::string::npos) << key << "\n" << c.text;
+  EXPECT_EQ(c.text.find("sac:"), std::string::npos) << "a td3 run does not use sac:";
+  EXPECT_EQ(c.text.find("dqn_refit:"), std::string::npos);
+  // Spelling out a default, or a section the run does not use, changes nothing.
+  EXPECT_EQ(load_coopt_config(kCi, {"trainer.pilot_labels=false", "sac.gamma=0.5"}).text, c.text);
+  EXPECT_NE(load_coopt_config(kCi, {"trainer.pilot_labels=true"}).text, c.text);
+  const CooptConfig sac = load_coopt_config(kCi, {"trainer.motion_algo=sac"});
+  EXPECT_NE(sac.text.find("sac:\n  gamma:"), std::string::npos);
+  EXPECT_EQ(sac.text.find("td3:"), std::string::npos);
+  const CooptConfig fixed = load_coopt_config(kCi, {"trainer.mode=fixed"});
+  EXPECT_EQ(fixed.text.find("dqn:"), std::string::npos);
+}
+
+// `base:` names the preset a file builds on; its keys apply first.
+TEST(CooptConfig, APresetBuildsOnItsBase) {
+  const std::string dir = test_support::fresh_temp_dir("preset_base");
+  std::filesystem::copy_file(kCi, dir + "/ci.yaml");
+  std::ofstream(dir + "/longer.yaml") << "base: ci.yaml\ntrainer:\n  episodes: 9  # why: longer\ntd3:\n  hidden_sizes: [16]\n";
+  const CooptConfig longer = load_coopt_config(dir + "/longer.yaml");
+  EXPECT_EQ(longer.trainer.episodes, 9);
+  EXPECT_EQ(longer.td3.hidden_sizes, std::vector<int>{16});
+  // The rest is the base's: the same run as the base with those two keys set.
+  EXPECT_EQ(longer.text, load_coopt_config(kCi, {"trainer.episodes=9", "td3.hidden_sizes=[16]"}).text);
+  EXPECT_EQ(longer.preset, "longer");
+  // A fault names the file that has it, with the line.
+  std::ofstream(dir + "/bad.yaml") << "base: longer.yaml\ntrainer:\n  episodes: -1\n";
+  EXPECT_EQ(test_support::error_of([&] { load_coopt_config(dir + "/bad.yaml"); }),
+            dir + "/bad.yaml: field 'trainer.episodes': value -1 out of range [0, 10000000] (line 3)");
+  std::ofstream(dir + "/missing.yaml") << "base: nothere.yaml\n";
+  EXPECT_NE(test_support::error_of([&] { load_coopt_config(dir + "/missing.yaml"); })
+                .find(dir + "/missing.yaml: field 'base': no preset '" + dir + "/nothere.yaml' (line 1)"),
+            std::string::npos);
+  std::ofstream(dir + "/loop.yaml") << "base: loop.yaml\n";
+  EXPECT_NE(test_support::error_of([&] { load_coopt_config(dir + "/loop.yaml"); }).find("more than 8 presets deep"),
+            std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+// An empty file is refused as empty (not as a file without a td3: section);
+// a key that is a list names the file and the line.
+TEST(CooptConfig, AnEmptyFileOrAListKeyIsRefusedAsSuch) {
+  EXPECT_EQ(test_support::error_of([] { coopt_config_from_text("", "empty.yaml"); }).rfind("empty.yaml: empty config", 0),
+            0u);
+  EXPECT_EQ(test_support::error_of([] { coopt_config_from_text("# only a comment\n", "c.yaml"); }).rfind("c.yaml: empty config", 0),
+            0u);
+  EXPECT_EQ(test_support::error_of([] { coopt_config_from_text("trainer:\n  [episodes]: 3\n", "l.yaml"); }),
+            "l.yaml: line 2: a key must be a name, not a list");
+  EXPECT_EQ(test_support::error_of([] { coopt_config_from_text("trainer:\n  - episodes: 3\n", "s.yaml"); }),
+            "s.yaml: field 'trainer': expected a mapping (line 2)");
+}
+
+// `comorph config keys` lists every key of every section with its default,
+// type and range, and meaning; with a preset, its values and what differs.
+TEST(ConfigReference, KeysListEveryFieldWithDefaultRangeAndMeaning) {
+  const std::string all = config_keys_text();
+  for (const char* line : {"trainer: The hierarchical trainer", "  trainer.episodes ", "4000",
+                           "integer in [0, 10000000]", "training episodes after the warm-up", "env.robot.wheel_radius",
+                           "td3.actor_q_weight", "sac.alpha", "dqn.discount_per", "step | decision", "eval.workers",
+                           "perception.switch_detector.agreement"})
+    EXPECT_NE(all.find(line), std::string::npos) << line;
+  const CooptConfig ci = load_coopt_config(kCi);
+  const std::string preset = config_keys_text(&ci);
+  // ci sets 4 training episodes (default 4000) and keeps the default mode.
+  EXPECT_NE(preset.find("* trainer.episodes "), std::string::npos) << preset.substr(0, 2000);
+  EXPECT_NE(preset.find("  trainer.mode "), std::string::npos);
+  EXPECT_EQ(preset.find("* trainer.mode "), std::string::npos);
+}
+
+// docs/config.md is the generated list; regenerate it when this fails.
+TEST(ConfigReference, DocsConfigMdIsInStepWithTheCode) {
+  const std::string page = std::string(COMORPH_SOURCE_DIR) + "/docs/config.md";
+  EXPECT_EQ(test_support::read_text(page), config_reference_markdown())
+      << "docs/config.md is out of date: build/apps/comorph config keys --markdown > docs/config.md";
 }
 
 void expect_error(const std::vector<std::string>& sets, const std::string& needle) {

@@ -107,7 +107,7 @@ TEST(Metrics, NoSuccessGivesNullTimeAndEnergy) {
 
 TEST(Metrics, HeightsWithoutEpisodesAreLeftOutOfTheMean) {
   auto log = hand_log();
-  const EvalSummary m = summarize({log[0], log[1]});  // 0.04 m only
+  const EvalSummary m = summarize({log[0], log[1]}, {}, {0.04, 0.06, 0.08});  // 0.04 m only
   EXPECT_TRUE(std::isnan(m.success_rate.at("0.06")));
   EXPECT_DOUBLE_EQ(m.success_rate.at("avg"), 0.5);
   EXPECT_TRUE(to_json(m)["success_rate"]["0.08"].is_null());

@@ -254,6 +254,52 @@ TEST(Report, MissingFilesAreNamed) {
   EXPECT_THROW(write_report({runs.hier.string()}, options), std::runtime_error);
 }
 
+// A damaged episodes.csv is refused with the file, the line and the fault,
+// and no output directory is left behind.
+TEST(Report, ADamagedEpisodeLogIsRefusedAndLeavesNoOutput) {
+  TinyRuns runs;
+  const fs::path csv = runs.fixed4 / "episodes.csv";
+  const std::string good = slurp(csv.string());
+  const std::string header = good.substr(0, good.find('\n') + 1);
+  const std::string row1 = good.substr(header.size(), good.find('\n', header.size()) + 1 - header.size());
+  struct Damage {
+    std::string text, expected;
+  };
+  std::string with_nan;
+  {
+    // return_R1 is the 11th column: replace it by nan.
+    std::vector<std::string> fields;
+    std::string row = row1.substr(0, row1.size() - 1);
+    for (std::size_t start = 0, comma = 0; comma != std::string::npos; start = comma + 1) {
+      comma = row.find(',', start);
+      fields.push_back(row.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    }
+    fields[10] = "nan";
+    with_nan = header + fmt::format("{}\n", fmt::join(fields, ","));
+  }
+  const std::vector<Damage> damages{
+      {header + "garbage\n", ":2:"},
+      {header + row1.substr(0, row1.size() / 2), ":2:"},  // a row cut mid-field
+      {"episode_no" + good.substr(good.find(',')), "header lacks column 'episode'"},
+      {"", ":1:1: empty file"},
+      {with_nan, "'nan' is not a finite number"},
+      {header + row1 + row1, "episode 0 appears twice (also on line 2)"}};
+  ReportOptions options;
+  options.out_dir = (runs.root / "out").string();
+  for (const Damage& d : damages) {
+    std::ofstream(csv, std::ios::trunc) << d.text;
+    try {
+      write_report({runs.hier.string(), runs.fixed4.string()}, options);
+      ADD_FAILURE() << "accepted " << d.text.substr(0, 200);
+    } catch (const std::runtime_error& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(csv.string()), std::string::npos) << msg;
+      EXPECT_NE(msg.find(d.expected), std::string::npos) << msg;
+    }
+    EXPECT_FALSE(fs::exists(options.out_dir)) << d.expected;
+  }
+}
+
 TEST(Report, BadRunYamlIsNamed) {
   TinyRuns runs;
   std::ofstream(runs.fixed4 / "run.yaml") << "kind: fixed\nmodules: 4\nalgo: ppo\n";
