@@ -325,7 +325,12 @@ void Trainer::Impl::take_motion_model(const std::string& run_dir) {
   const CheckpointInfo source = read_checkpoint_info(run_dir);
   const std::string path = (std::filesystem::path(source.directory) / "motion_actor.pt").string();
   try {
-    load_learner_file(*state.motion, path);
+    // The networks only: this run's learner counts its own (no) transitions.
+    state.motion->load_acting_networks(path);
+  } catch (const c10::Error& e) {
+    throw std::runtime_error("trainer.refit_motion_from: " + path + ": its motion model does not fit this run's (" +
+                             config.trainer.motion_algo + ", the motion inputs and network sizes must be the same): " +
+                             e.what_without_backtrace());
   } catch (const std::exception& e) {
     throw std::runtime_error("trainer.refit_motion_from: " + path + ": its motion model does not fit this run's (" +
                              config.trainer.motion_algo + ", the motion inputs and network sizes must be the same): " +

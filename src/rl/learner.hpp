@@ -66,6 +66,13 @@ class Learner {
   // file the learner acts as the saved one did (greedy), and everything else
   // stays as constructed, so it cannot continue training exactly.
   virtual void save_policy(const std::string& path) const = 0;
+  // The acting networks alone from a policy file or a full checkpoint (what
+  // Policy::load reads); counters, RNG, optimizers and replay stay as they
+  // are. Another run's trained model as a starting point (coopt's
+  // trainer.refit_motion_from). Learners that cannot say so throw.
+  virtual void load_acting_networks(const std::string& path) {
+    throw std::logic_error("this learner cannot load acting networks alone (" + path + ")");
+  }
   // The replay buffer, and save() without it: the hierarchical trainer writes
   // the buffer apart, as segments (rl/replay_segments.hpp). load() of such a
   // file leaves replay() as it is.

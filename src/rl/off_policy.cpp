@@ -95,6 +95,16 @@ void OffPolicyLearner::save_policy(const std::string& path) const {
   save_policy_file(path, acting_module(), key_, counters_, rng_, algorithm_);
 }
 
+void OffPolicyLearner::load_acting_networks(const std::string& path) {
+  torch::serialize::InputArchive a, nets;
+  a.load_from(path, device_);
+  a.read(key_, nets);  // a policy file's networks, or a full checkpoint's online networks
+  acting_module().load(nets);
+  const CheckpointParts parts = checkpoint_parts();
+  for (const auto& [key, optimizer] : parts.optimizers) optimizer->rebind();
+  for (FlatParameters* f : parts.flat) f->rebind();
+}
+
 void OffPolicyLearner::load(const std::string& path) {
   torch::serialize::InputArchive a;
   a.load_from(path, device_);

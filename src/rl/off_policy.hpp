@@ -83,6 +83,7 @@ class OffPolicyLearner : public Learner {
   void save_without_replay(const std::string& path) const final { save_to(path, false); }
   void load(const std::string& path) final;
   void save_policy(const std::string& path) const final;
+  void load_acting_networks(const std::string& path) final;
   ReplayBuffer& replay() final { return replay_; }
   const LearnerCounters& counters() const final { return counters_; }
   const torch::nn::Module& acting_networks() const final { return acting_module(); }

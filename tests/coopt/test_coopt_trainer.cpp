@@ -533,6 +533,12 @@ TEST(Trainer, RefitOfAnotherRunsMotionModel) {
   const auto from_a = evaluate(load_coopt_config(kCi), a, req);
   const auto from_b = evaluate(load_coopt_config(kCi, refit), b, req);
   for (int i = 0; i < 2; ++i) EXPECT_EQ(line_of(from_a[i]), line_of(from_b[i])) << i;
+  {
+    // Its checkpoint resumes: the learner counts this run's transitions (none), not the source's.
+    Trainer resumed(load_coopt_config(kCi, refit), b);
+    EXPECT_NO_THROW(resumed.resume());
+    EXPECT_EQ(resumed.episodes_done(), 3);
+  }
   // Only a refit may take another run's motion model.
   EXPECT_THROW(load_coopt_config(kCi, {"trainer.refit_motion_from=" + a}), std::runtime_error);
   const std::string missing = temp_dir("no_such_run"), bad = temp_dir("refit_bad");
