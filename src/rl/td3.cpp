@@ -127,18 +127,12 @@ void Td3::update_with_autograd(const ReplayBatch& b, const torch::Tensor& smooth
     const torch::Tensor actor_f = nets_->actor_features(b.image, b.vector, critic_f);
     const torch::Tensor pi = torch::tanh(nets_->actor_head(actor_f));
     const torch::Tensor q = nets_->q1(critic_f, pi);
-    torch::Tensor actor_loss;
-    if (config_.bc_weight > 0) {
-      // Q normalised by its batch magnitude, so that w means the same at any reward scale.
-      const double w = bc_weight_now();
-      actor_loss = -q.mean() / q.abs().mean().detach().clamp_min(1e-6);
-      if (config_.actor_q_weight != 1) actor_loss = config_.actor_q_weight * actor_loss;
-      if (w > 0)
-        actor_loss = actor_loss + w * ((pi - b.target).pow(2).sum(1) * b.has_target).mean();
-    } else {
-      actor_loss = -q.mean();
-      if (config_.actor_q_weight != 1) actor_loss = config_.actor_q_weight * actor_loss;
-    }
+    // With behaviour cloning, Q normalised by its batch magnitude, so that w means the same at any reward scale.
+    const bool bc = config_.bc_weight > 0;
+    torch::Tensor actor_loss = bc ? -q.mean() / q.abs().mean().detach().clamp_min(1e-6) : -q.mean();
+    if (config_.actor_q_weight != 1) actor_loss = config_.actor_q_weight * actor_loss;
+    const double w = bc ? bc_weight_now() : 0.0;
+    if (w > 0) actor_loss = actor_loss + w * ((pi - b.target).pow(2).sum(1) * b.has_target).mean();
     gradient_step(*actor_optimizer_, actor_loss, config_.max_grad_norm);
     actor_step_done();
   }
