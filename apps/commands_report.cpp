@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "cli_numbers.hpp"
+#include "coopt/config.hpp"
 #include "command_registry.hpp"
 #include "report/metrics.hpp"
 #include "report/render_episode.hpp"
@@ -34,6 +35,7 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
       ->capture_default_str()
       ->check(comorph::cli::whole_in(1, 1000000));
   report->callback([] {
+    options.config_identity = comorph::coopt::config_identity;
     const auto result = comorph::report::write_report(runs, options);
     std::cout << "wrote " << result.markdown_path << ", " << result.html_path << " and " << result.images.size()
               << " image(s)\n";

@@ -167,13 +167,10 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   }
   if (p.config_refit_episodes > 0 && p.mode != TrainerMode::hierarchical)
     fail(source, pre + ".config_refit_episodes", "needs trainer.mode hierarchical (a fixed chain has no DQN)");
-  if (p.scene_source == SceneSourceKind::classifier) {
-    if (p.classifier_dir.empty())
-      fail(source, pre + ".classifier_dir", "scene_source: classifier needs the directory of a trained classifier");
-    if (!std::filesystem::exists(std::filesystem::path(p.classifier_dir) / "classifier.pt"))
-      fail(source, pre + ".classifier_dir", "no classifier.pt in '" + quote_value(p.classifier_dir) +
-                                                "' (train one with `comorph classifier train`)");
-  }
+  // Whether the directory holds a classifier is checked where it is loaded
+  // (SceneSource): a config's settings read the same on any machine.
+  if (p.scene_source == SceneSourceKind::classifier && p.classifier_dir.empty())
+    fail(source, pre + ".classifier_dir", "scene_source: classifier needs the directory of a trained classifier");
   return p;
 }
 
@@ -381,6 +378,12 @@ CooptConfig coopt_config_from_text(const std::string& text, const std::string& s
 
 CooptConfig load_coopt_config(const std::string& path, const std::vector<std::string>& sets) {
   return coopt_config_from_text(read_text_file(path), path, sets);
+}
+
+std::string config_identity(const std::string& path) {
+  YAML::Node resolved = YAML::Load(load_coopt_config(path).text);
+  resolved["trainer"].remove("seed");
+  return YAML::Dump(resolved);
 }
 
 std::vector<double> stair_heights(const CooptConfig& config) {

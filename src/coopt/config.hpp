@@ -217,6 +217,12 @@ CooptConfig load_coopt_config(const std::string& path, const std::vector<std::st
 CooptConfig coopt_config_from_text(const std::string& text, const std::string& source,
                                    const std::vector<std::string>& sets = {});
 
+// A run's config.yaml resolved (defaults filled in), without trainer.seed:
+// equal for runs of the same settings, whether their file was written resolved
+// or as the merged input (runs made before configs were resolved).
+// report::ConfigIdentity for the reports and `experiment --collect`.
+std::string config_identity(const std::string& config_yaml_path);
+
 // The stair heights of the run's episodes, m, ascending: trainer.stair_height
 // when it is fixed, else the distinct heights of env.scene. Evaluations and
 // their summaries report each.

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "coopt/segment.hpp"
 #include "perception/scene_classifier.hpp"
@@ -81,6 +82,10 @@ task::EpisodeSpec eval_spec(const CooptConfig& c, const task::ScenarioSpec& scen
 
 SceneSource::SceneSource(const CooptConfig& c) : params_(c.perception.switch_detector), detector_(params_, 0, 3) {
   if (c.trainer.scene_source == SceneSourceKind::classifier) {
+    if (!std::filesystem::exists(std::filesystem::path(c.trainer.classifier_dir) / "classifier.pt"))
+      throw std::runtime_error("trainer.classifier_dir: no classifier.pt in '" + c.trainer.classifier_dir +
+                               "' (prepare one with `comorph classifier prepare --out " + c.trainer.classifier_dir +
+                               "`)");
     classifier_ = std::make_unique<perception::SceneClassifier>(
         perception::SceneClassifier::load(c.trainer.classifier_dir, &c.perception.classifier));
     monitor_ = std::make_unique<perception::SceneMonitor>(*classifier_, params_, 0);

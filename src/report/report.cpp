@@ -403,7 +403,7 @@ ReportResult write_report(const std::vector<std::string>& run_dirs, const Report
   const PaperReference paper = load_paper_reference(ref_path);
   // Everything is read before anything is written: a damaged input leaves no output behind.
   std::vector<RunDir> runs;
-  for (const auto& d : run_dirs) runs.push_back(load_run_dir(d));
+  for (const auto& d : run_dirs) runs.push_back(load_run_dir(d, options.config_identity));
   std::vector<CurveSeries> series;
   for (const auto& r : runs) series.push_back({r.info.name, read_episodes_csv(r.episodes_csv)});
   const bool created = !fs::exists(options.out_dir);

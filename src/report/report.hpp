@@ -16,6 +16,7 @@ struct ReportOptions {
   int curve_window = 100;           // episodes in the moving averages of the training curves
   bool require_plots = true;        // false: without gnuplot, write the report without curves (and say so)
   std::vector<std::string> missing; // runs an experiment lacks, one line each, listed under the tables
+  ConfigIdentity config_identity;   // how runs' config.yaml are compared (load_run_dir)
 };
 
 struct ReportResult {

@@ -67,7 +67,29 @@ void write_run_info(const std::string& path, const RunInfo& info) {
   write_file_atomic(path, std::string(out.c_str()) + "\n");
 }
 
-RunDir load_run_dir(const std::string& path) {
+namespace {
+
+// trainer.seed of a config.yaml; 0 when it has none.
+int config_seed(const std::string& path) {
+  const YAML::Node root = load_yaml_file(path);
+  const YAML::Node trainer = root.IsMap() ? root["trainer"] : YAML::Node();
+  if (!trainer.IsMap() || !trainer["seed"]) return 0;
+  try {
+    return trainer["seed"].as<int>();
+  } catch (const YAML::Exception&) {
+    throw std::runtime_error(fmt::format("{}: trainer.seed is not an integer", path));
+  }
+}
+
+}  // namespace
+
+std::string config_as_written(const std::string& path) {
+  YAML::Node root = load_yaml_file(path);
+  if (root.IsMap() && root["trainer"].IsMap()) root["trainer"].remove("seed");
+  return YAML::Dump(root);
+}
+
+RunDir load_run_dir(const std::string& path, const ConfigIdentity& identity) {
   if (!fs::is_directory(path)) throw std::runtime_error(fmt::format("run directory {} does not exist", path));
   RunDir run;
   run.path = path;
@@ -96,17 +118,8 @@ RunDir load_run_dir(const std::string& path) {
   }
   const fs::path config = dir / "config.yaml";
   if (fs::is_regular_file(config)) {
-    YAML::Node root = load_yaml_file(config.string());
-    YAML::Node trainer = root.IsMap() ? root["trainer"] : YAML::Node();
-    if (trainer.IsMap() && trainer["seed"]) {
-      try {
-        run.seed = trainer["seed"].as<int>();
-      } catch (const YAML::Exception&) {
-        throw std::runtime_error(fmt::format("{}: trainer.seed is not an integer", config.string()));
-      }
-      trainer.remove("seed");
-    }
-    run.config_key = YAML::Dump(root);
+    run.seed = config_seed(config.string());
+    run.config_key = identity ? identity(config.string()) : config_as_written(config.string());
   }
   return run;
 }

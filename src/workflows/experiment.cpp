@@ -211,7 +211,7 @@ void collect(const ExperimentOptions& o, const comorph::report::PaperReference& 
       });
       if (again) continue;
       try {
-        runs.push_back(comorph::report::load_run_dir(dir));
+        runs.push_back(comorph::report::load_run_dir(dir, comorph::coopt::config_identity));
         run_dirs.push_back(dir);
       } catch (const std::exception& e) {
         missing.push_back(e.what());
@@ -224,7 +224,7 @@ void collect(const ExperimentOptions& o, const comorph::report::PaperReference& 
         std::string why = missing_reason(run);
         if (why.empty()) {
           try {
-            runs.push_back(comorph::report::load_run_dir(run.dir));
+            runs.push_back(comorph::report::load_run_dir(run.dir, comorph::coopt::config_identity));
             run_dirs.push_back(run.dir);
           } catch (const std::exception& e) {
             why = e.what();
@@ -263,6 +263,7 @@ void collect(const ExperimentOptions& o, const comorph::report::PaperReference& 
   report.out_dir = (fs::path(o.out) / "report").string();
   report.require_plots = false;
   report.missing = missing;
+  report.config_identity = comorph::coopt::config_identity;
   const auto written = comorph::report::write_report(run_dirs, report);
   std::printf("wrote %s, %s and %s\n", table_path.c_str(), written.markdown_path.c_str(), written.html_path.c_str());
 }

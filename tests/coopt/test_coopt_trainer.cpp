@@ -562,6 +562,13 @@ TEST(Trainer, ClassifierSceneSourceRunsTheHierarchy) {
                              dir);
   EXPECT_EQ(r.logs.size(), 6u);
   EXPECT_FALSE(r.decisions.empty());
+  // A directory without a classifier is refused when the run starts, naming the key.
+  const std::string refused = test_support::error_of([&] {
+    run_ci({"trainer.scene_source=classifier", "trainer.classifier_dir=" + dir + "/none",
+            "perception.classifier.image_size=8", "perception.classifier.width=8"},
+           temp_dir("cls_none"));
+  });
+  EXPECT_NE(refused.find("trainer.classifier_dir: no classifier.pt in"), std::string::npos) << refused;
   fs::remove_all(dir);
   fs::remove_all(weights);
 }

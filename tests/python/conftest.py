@@ -40,9 +40,9 @@ def config_dir_with(tmp_path, **task_keys):
 
 
 # A trained run's config names its scene classifier relative to the working
-# directory (trainer.classifier_dir: runs/classifier), and loading it checks it
-# is there. `work` is a directory that has it: trained once by `comorph
-# classifier prepare` (seeded: always the same weights, ~2 min) and kept in
+# directory (trainer.classifier_dir: runs/classifier), and evaluating it loads
+# the classifier from there. `work` is a directory that has it: trained once by
+# `comorph classifier prepare` (seeded: always the same weights, ~2 min) and kept in
 # $COMORPH_TEST_WORK (build/tests/python/work under ctest);
 # COMORPH_CLASSIFIER_DIR may point to one already trained instead.
 @pytest.fixture(scope="session")
