@@ -29,8 +29,12 @@ struct PerceptionConfig {
   SwitchDetectorParams switch_detector;
 };
 
-// Every field of PerceptionConfig with its meaning (validate() checks the ranges).
+// Every field of PerceptionConfig with its range and meaning.
 void add_fields(YamlFields& f, PerceptionConfig& config);
+// The first value of `config` outside its range in add_fields, as an error
+// ("perception: field '<key>': value <v> out of range [min, max]"), or "".
+// The structs' validate() use it for values set in code.
+std::string range_fault(const PerceptionConfig& config);
 PerceptionConfig load_perception_config(const std::string& path);
 // `node` is the mapping above (e.g. the `perception:` section of a preset).
 PerceptionConfig perception_config_from_yaml(const YAML::Node& node, const std::string& source);

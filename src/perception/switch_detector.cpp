@@ -1,6 +1,8 @@
 // Scene-switch rule and switch-delay evaluation (switch_detector.hpp).
 #include "perception/switch_detector.hpp"
 
+#include "perception/perception_config.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -9,10 +11,11 @@
 namespace comorph::perception {
 
 std::string SwitchDetectorParams::validate() const {
-  if (interval < 1) return "switch_detector.interval must be >= 1 control step, got " + std::to_string(interval);
-  if (window < 1) return "switch_detector.window must be >= 1 frame, got " + std::to_string(window);
-  if (!(agreement >= 0.0 && agreement < 1.0))
-    return "switch_detector.agreement must be in [0, 1), got " + std::to_string(agreement);
+  PerceptionConfig config;
+  config.switch_detector = *this;
+  if (std::string fault = range_fault(config); !fault.empty()) return fault;
+  // The range is closed; an agreement of 1 would need more votes than the window has.
+  if (agreement >= 1.0) return "switch_detector.agreement must be below 1, got " + std::to_string(agreement);
   return "";
 }
 

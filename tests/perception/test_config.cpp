@@ -43,7 +43,10 @@ TEST(PerceptionConfig, ReadsValuesAndRejectsBadOnes) {
 
   EXPECT_NE(error_of("classifier: {widht: 8}").find("classifier.widht': unknown field"), std::string::npos);
   EXPECT_NE(error_of("bogus: 1").find("'bogus': unknown field"), std::string::npos);
-  EXPECT_NE(error_of("switch_detector: {agreement: 1.5}").find("agreement must be in [0, 1)"),
+  EXPECT_NE(error_of("switch_detector: {agreement: 1.5}").find("agreement': value 1.5 out of range [0, 1]"),
+            std::string::npos);
+  EXPECT_NE(error_of("switch_detector: {agreement: 1}").find("agreement must be below 1"), std::string::npos);
+  EXPECT_NE(error_of("training: {batch_size: 1}").find("training.batch_size': value 1 out of range [2, 1000000]"),
             std::string::npos);
   EXPECT_NE(error_of("training: {epochs: many}").find("training.epochs': bad value"), std::string::npos);
   EXPECT_NE(error_of("classifier: {classes: 4}").find("class_names has 3 names for 4 classes"),
