@@ -4,6 +4,10 @@
 #include <torch/torch.h>
 
 #include <algorithm>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
 
 #include "coopt/segment.hpp"
 #include "coopt/training_state.hpp"
@@ -59,6 +63,11 @@ int block_end(const TrainerParams& t, int from) {
 // part of the run, so this too follows the run and not the timing.
 int step_cost(int modules) { return 2 * modules + 1; }
 int round_quota(const TrainerParams& t) { return t.sync_interval * step_cost(4); }
+
+int most_round_transitions(const TrainerParams& t, int actors) {
+  if (actors == 1) return t.sync_interval;
+  return (round_quota(t) + step_cost(kMinModules) - 1) / step_cost(kMinModules) + t.motion_n_step - 1;
+}
 
 void allocate_transitions(const CooptConfig& c, std::vector<Transition>& v, std::size_t n) {
   v.resize(n);
@@ -117,13 +126,7 @@ Actor::Actor(const CooptConfig& c, int actors, const std::function<int(int, int)
   agent_.config = make_config_policy(c, false);
   if (t.config_refit_episodes > 0) other_config_ = make_config_policy(c, true);
   configure_pilot(t, pilot_);
-  // The most transitions a round can hold. One actor: an interval. Lockstep:
-  // the quota in steps of the shortest chain, and the n - 1 an n-step return
-  // held back from the round before.
-  const int most = one_actor_ ? t.sync_interval
-                              : (round_quota(t) + step_cost(kMinModules) - 1) / step_cost(kMinModules) +
-                                    t.motion_n_step - 1;
-  allocate_transitions(c, rollout_.transitions, static_cast<std::size_t>(most));
+  allocate_transitions(c, rollout_.transitions, static_cast<std::size_t>(most_round_transitions(t, actors)));
 }
 
 void Actor::take(const ActingWeights& weights, const Orders& orders) {
@@ -263,6 +266,146 @@ void Actor::play(int episode, ActorLink& link) {
   rollout_.motion_counters = agent_.motion->counters();
   if (agent_.config) rollout_.config_rng = agent_.config->rng();
   laps.lap(kOther);
+}
+
+namespace {
+
+// Plain values and vectors of them, appended in order and read back in the
+// same order (one program on every rank: the same sizes and layouts).
+struct ByteWriter {
+  std::vector<char>& out;
+  template <class T>
+  void put(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const char* p = reinterpret_cast<const char*>(&v);
+    out.insert(out.end(), p, p + sizeof(T));
+  }
+  template <class T>
+  void put(const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    put(v.size());
+    const char* p = reinterpret_cast<const char*>(v.data());
+    out.insert(out.end(), p, p + v.size() * sizeof(T));
+  }
+  void put(const std::string& s) {
+    put(s.size());
+    out.insert(out.end(), s.begin(), s.end());
+  }
+};
+
+struct ByteReader {
+  const std::vector<char>& in;
+  std::size_t at = 0;
+  const char* take(std::size_t n) {
+    if (at + n > in.size()) throw std::runtime_error("acting protocol: a message ends early (another program version?)");
+    const char* p = in.data() + at;
+    at += n;
+    return p;
+  }
+  template <class T>
+  void get(T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    std::memcpy(&v, take(sizeof(T)), sizeof(T));
+  }
+  template <class T>
+  void get(std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    std::size_t n = 0;
+    get(n);
+    v.resize(n);
+    if (n > 0) std::memcpy(v.data(), take(n * sizeof(T)), n * sizeof(T));
+  }
+  void get(std::string& s) {
+    std::size_t n = 0;
+    get(n);
+    const char* p = take(n);
+    s.assign(p, p + n);
+  }
+};
+
+// One field list for both directions: put() for a writer, get() for a reader.
+struct Put {
+  ByteWriter w;
+  template <class T>
+  void operator()(const T& v) { w.put(v); }
+};
+struct Get {
+  ByteReader r;
+  template <class T>
+  void operator()(T& v) { r.get(v); }
+};
+
+template <class F, class T>
+void transition_fields(F& f, T& t) {
+  f(t.obs.image), f(t.obs.vector), f(t.obs.valid_actions);
+  f(t.next.image), f(t.next.vector), f(t.next.valid_actions);
+  f(t.action.discrete), f(t.action.continuous), f(t.action.target);
+  f(t.reward), f(t.terminated), f(t.truncated), f(t.steps);
+}
+
+template <class F, class L>
+void episode_log_fields(F& f, L& l) {
+  f(l.episode), f(l.seed), f(l.scenario), f(l.stair_height_m), f(l.obstacles), f(l.success), f(l.termination);
+  f(l.time_s), f(l.energy_J), f(l.distance_fraction), f(l.return_R1), f(l.configurations), f(l.modules_total);
+  f(l.stairs_climbed), f(l.action_saturation);
+  f(l.return_R2), f(l.F), f(l.steps), f(l.switches), f(l.stairs_energy_J), f(l.first_segment_R2);
+  f(l.first_segment_R1), f(l.first_segment_steps), f(l.warmup);
+}
+
+template <class F, class R>
+void rollout_head_fields(F& f, R& r) {
+  f(r.stored), f(r.steps), f(r.decision_logs), f(r.ended), f(r.rng), f(r.motion_rng), f(r.config_rng);
+  f(r.motion_counters);
+}
+
+template <class F, class W, class O>
+void release_fields(F& f, W& w, O& o) {
+  f(w.motion_version), f(w.motion), f(w.config_version), f(w.config_refit), f(w.config), f(w.config_counters);
+  f(o.episode), f(o.start), f(o.rng), f(o.motion_rng), f(o.set_motion_counters), f(o.motion_counters);
+  f(o.set_config_rng), f(o.config_rng);
+}
+
+}  // namespace
+
+void rollout_to_bytes(const Rollout& r, std::vector<char>& bytes) {
+  bytes.clear();
+  Put f{{bytes}};
+  rollout_head_fields(f, r);
+  for (int i = 0; i < r.stored; ++i) transition_fields(f, r.transitions[static_cast<std::size_t>(i)]);
+  f(r.decisions.size());
+  for (const StoredDecision& d : r.decisions) {
+    transition_fields(f, d.transition);
+    f(d.k);
+  }
+  if (r.ended) episode_log_fields(f, r.log);
+}
+
+void rollout_from_bytes(const std::vector<char>& bytes, Rollout& r) {
+  Get f{{bytes}};
+  rollout_head_fields(f, r);
+  if (r.stored > static_cast<int>(r.transitions.size()))
+    throw std::runtime_error("acting protocol: a rollout of " + std::to_string(r.stored) +
+                             " transitions, more than a round holds (another config?)");
+  for (int i = 0; i < r.stored; ++i) transition_fields(f, r.transitions[static_cast<std::size_t>(i)]);
+  std::size_t decisions = 0;
+  f(decisions);
+  r.decisions.resize(decisions);
+  for (StoredDecision& d : r.decisions) {
+    transition_fields(f, d.transition);
+    f(d.k);
+  }
+  if (r.ended) episode_log_fields(f, r.log);
+}
+
+void release_to_bytes(const ActingWeights& w, const Orders& o, std::vector<char>& bytes) {
+  bytes.clear();
+  Put f{{bytes}};
+  release_fields(f, w, o);
+}
+
+void release_from_bytes(const std::vector<char>& bytes, ActingWeights& w, Orders& o) {
+  Get f{{bytes}};
+  release_fields(f, w, o);
 }
 
 }  // namespace comorph::coopt

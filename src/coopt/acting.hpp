@@ -135,6 +135,19 @@ struct Orders {
   std::mt19937_64 config_rng;
 };
 
+// The values as bytes, for a transport between processes (coopt/actor_ranks.hpp).
+// Reading into a value of the same run's sizes allocates nothing for its
+// transitions (Rollout::transitions preallocated) and weights.
+void rollout_to_bytes(const Rollout& r, std::vector<char>& bytes);
+void rollout_from_bytes(const std::vector<char>& bytes, Rollout& r);
+void release_to_bytes(const ActingWeights& w, const Orders& o, std::vector<char>& bytes);
+void release_from_bytes(const std::vector<char>& bytes, ActingWeights& w, Orders& o);
+
+// The most transitions one round of one actor can hand over: an interval
+// with one actor; in lockstep the quota in steps of the shortest chain, and
+// the n - 1 an n-step return held back from the round before.
+int most_round_transitions(const TrainerParams& t, int actors);
+
 // Thrown by an ActorLink when the host ends the run.
 struct ActorStopped {};
 
