@@ -5,15 +5,22 @@
 
 #include <torch/torch.h>
 
+#include "coopt/actor_ranks.hpp"
 #include "coopt/actor_threads.hpp"
 #include "coopt/learner_host.hpp"
 
 namespace comorph::coopt {
 
-Trainer::Trainer(const CooptConfig& config, const std::string& run_dir, TrainerCallbacks callbacks)
-    : host_(std::make_unique<LearnerHost>(config, run_dir, callbacks, config.trainer.simulation_threads)),
-      actors_(std::make_unique<ActorThreads>(host_->config(), config.trainer.simulation_threads,
-                                             callbacks.label_source)) {}
+Trainer::Trainer(const CooptConfig& config, const std::string& run_dir, TrainerCallbacks callbacks,
+                 ActorPlacement actors) {
+  const bool ranks = actors == ActorPlacement::mpi_ranks;
+  const int n = ranks ? mpi_actor_ranks() : config.trainer.simulation_threads;
+  host_ = std::make_unique<LearnerHost>(config, run_dir, callbacks, n);
+  if (ranks)
+    actors_ = std::make_unique<ActorRanks>(host_->config());
+  else
+    actors_ = std::make_unique<ActorThreads>(host_->config(), n, callbacks.label_source);
+}
 // The actors first: their threads use the host's config.
 Trainer::~Trainer() { actors_.reset(); }
 

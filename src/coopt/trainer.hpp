@@ -146,12 +146,44 @@ struct TrainerTiming {
   int checkpoints = 0;          // checkpoints written by run()
 };
 
+// This process's place in an MPI job that mpirun (OpenMPI) started: joined at
+// construction when the job has 2 ranks or more, left at destruction. Rank 0
+// trains with the other ranks as its actors (ActorPlacement::mpi_ranks); every
+// other rank serves as an actor (serve_actor_rank). Outside mpirun, or with
+// one rank, nothing happens.
+class MpiJob {
+ public:
+  MpiJob();
+  ~MpiJob();
+  MpiJob(const MpiJob&) = delete;
+  MpiJob& operator=(const MpiJob&) = delete;
+  bool joined() const { return size_ > 1; }
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  // Ends every rank of the job with `code` (after an error on this one).
+  void abort(int code) const;
+
+ private:
+  int rank_ = 0, size_ = 1;
+};
+
+// Where the trainer's actors run: trainer.simulation_threads threads of this
+// process, or the other ranks of the MPI job this process is rank 0 of (one
+// actor each; trainer.simulation_threads is then unused). The same seed and
+// number of actors give the same results either way.
+enum class ActorPlacement { threads, mpi_ranks };
+
+// An actor rank of an MPI job: plays what rank 0's trainer orders until that
+// trainer ends the run. `config` must be the run's.
+void serve_actor_rank(const CooptConfig& config);
+
 class Trainer {
  public:
   // run_dir must exist. The trainer writes, through coopt/run_store.hpp,
   // config.yaml, run.yaml, episodes.csv, evaluations.csv and checkpoint/
   // (`comorph eval` adds its files beside them).
-  Trainer(const CooptConfig& config, const std::string& run_dir, TrainerCallbacks callbacks = {});
+  Trainer(const CooptConfig& config, const std::string& run_dir, TrainerCallbacks callbacks = {},
+          ActorPlacement actors = ActorPlacement::threads);
   ~Trainer();
   // Loads run_dir's latest checkpoint; throws (naming the difference) when it
   // was written by another configuration. Truncates episodes.csv and

@@ -1,0 +1,129 @@
+#include "coopt/actor_ranks.hpp"
+
+#include <mpi.h>
+#include <torch/torch.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+#include <thread>
+
+namespace comorph::coopt {
+namespace {
+
+enum Tag { kRelease = 1, kRollout = 2, kStop = 3 };
+
+void check(int code, const char* what) {
+  if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI: ") + what + " failed");
+}
+
+// Waits for a message from `source` (any tag) without spinning on the core.
+MPI_Status wait_for_message(int source) {
+  MPI_Status status;
+  int arrived = 0;
+  while (true) {
+    check(MPI_Iprobe(source, MPI_ANY_TAG, MPI_COMM_WORLD, &arrived, &status), "MPI_Iprobe");
+    if (arrived) return status;
+    std::this_thread::sleep_for(std::chrono::microseconds(50));
+  }
+}
+
+void receive(int source, const MPI_Status& status, std::vector<char>& bytes) {
+  int size = 0;
+  check(MPI_Get_count(&status, MPI_BYTE, &size), "MPI_Get_count");
+  bytes.resize(static_cast<std::size_t>(size));
+  check(MPI_Recv(bytes.data(), size, MPI_BYTE, source, status.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE), "MPI_Recv");
+}
+
+void send(const std::vector<char>& bytes, int dest, int tag) {
+  check(MPI_Send(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, dest, tag, MPI_COMM_WORLD), "MPI_Send");
+}
+
+// An actor rank's side: the host is rank 0.
+class RankLink final : public ActorLink {
+ public:
+  void exchange(const Rollout* rollout, const ActingWeights*& weights, const Orders*& orders) override {
+    if (rollout) {
+      rollout_to_bytes(*rollout, bytes_);
+      send(bytes_, 0, kRollout);
+    }
+    const MPI_Status status = wait_for_message(0);
+    receive(0, status, bytes_);
+    if (status.MPI_TAG == kStop) throw ActorStopped{};
+    release_from_bytes(bytes_, weights_, orders_);
+    weights = &weights_;
+    orders = &orders_;
+  }
+
+ private:
+  std::vector<char> bytes_;
+  ActingWeights weights_;
+  Orders orders_;
+};
+
+}  // namespace
+
+MpiJob::MpiJob() {
+  // mpirun (OpenMPI) names the job's size; a program started alone stays out of MPI.
+  const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
+  if (!size || std::atoi(size) < 2) return;
+  int provided = 0;
+  check(MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
+  check(MPI_Comm_rank(MPI_COMM_WORLD, &rank_), "MPI_Comm_rank");
+  check(MPI_Comm_size(MPI_COMM_WORLD, &size_), "MPI_Comm_size");
+}
+
+MpiJob::~MpiJob() {
+  if (size_ > 1) MPI_Finalize();
+}
+
+void MpiJob::abort(int code) const {
+  std::fflush(stderr);
+  MPI_Abort(MPI_COMM_WORLD, code);
+}
+
+int mpi_actor_ranks() {
+  int initialized = 0;
+  MPI_Initialized(&initialized);
+  if (!initialized) throw std::logic_error("actors on MPI ranks: this process is not part of an MPI job (mpirun)");
+  int size = 0;
+  check(MPI_Comm_size(MPI_COMM_WORLD, &size), "MPI_Comm_size");
+  return size - 1;
+}
+
+ActorRanks::ActorRanks(const CooptConfig& c) : received_(static_cast<std::size_t>(mpi_actor_ranks())) {
+  rollouts_.assign(received_.size(), nullptr);
+  const int most = most_round_transitions(c.trainer, actors());
+  for (Rollout& r : received_) allocate_transitions(c, r.transitions, static_cast<std::size_t>(most));
+}
+
+ActorRanks::~ActorRanks() {
+  const std::vector<char> none;
+  for (int rank = 1; rank <= actors(); ++rank) MPI_Send(none.data(), 0, MPI_BYTE, rank, kStop, MPI_COMM_WORLD);
+}
+
+std::vector<Rollout*>& ActorRanks::round(const ActingWeights& weights, const std::vector<Orders>& orders) {
+  for (int i = 0; i < actors(); ++i) {
+    release_to_bytes(weights, orders[static_cast<std::size_t>(i)], bytes_);
+    send(bytes_, i + 1, kRelease);
+  }
+  for (int i = 0; i < actors(); ++i) {
+    rollouts_[static_cast<std::size_t>(i)] = nullptr;
+    if (orders[static_cast<std::size_t>(i)].episode < 0) continue;
+    const MPI_Status status = wait_for_message(i + 1);
+    receive(i + 1, status, bytes_);
+    Rollout& r = received_[static_cast<std::size_t>(i)];
+    rollout_from_bytes(bytes_, r);
+    rollouts_[static_cast<std::size_t>(i)] = &r;
+  }
+  return rollouts_;
+}
+
+void serve_actor_rank(const CooptConfig& config) {
+  Actor actor(config, mpi_actor_ranks(), {});
+  RankLink link;
+  actor.serve(link);
+}
+
+}  // namespace comorph::coopt

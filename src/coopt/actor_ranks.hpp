@@ -1,0 +1,36 @@
+// The acting protocol's transport between the ranks of an MPI job
+// (coopt/acting.hpp): rank 0 is the learner host, ranks 1..K-1 are actors.
+// A round: the host sends each actor rank the weights and its orders as one
+// message, then receives the rollout of each actor with an episode, in actor
+// order (the values as bytes: rollout_to_bytes, release_to_bytes). Waiting
+// polls with short sleeps, so a waiting rank leaves its core to the others.
+// Internal to coopt; the public face is coopt/trainer.hpp (MpiJob,
+// ActorPlacement, serve_actor_rank).
+#pragma once
+
+#include <vector>
+
+#include "coopt/acting.hpp"
+
+namespace comorph::coopt {
+
+// The job's actor ranks (its size - 1); throws outside an MPI job.
+int mpi_actor_ranks();
+
+class ActorRanks final : public ActorTransport {
+ public:
+  // The job's other ranks; the job is joined (MpiJob).
+  explicit ActorRanks(const CooptConfig& c);
+  ~ActorRanks() override;  // tells every actor rank that the run ended
+  int actors() const override { return static_cast<int>(rollouts_.size()); }
+  std::vector<Rollout*>& round(const ActingWeights& weights, const std::vector<Orders>& orders) override;
+  // The actors' laps stay on their ranks: zeros here.
+  std::array<Clock::duration, kPhases> actor_time() const override { return {}; }
+
+ private:
+  std::vector<Rollout> received_;  // by actor, preallocated
+  std::vector<Rollout*> rollouts_;
+  std::vector<char> bytes_;
+};
+
+}  // namespace comorph::coopt
