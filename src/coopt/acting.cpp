@@ -358,9 +358,10 @@ void rollout_head_fields(F& f, R& r) {
   f(r.motion_counters);
 }
 
+// A release: these, then the two weight buffers.
 template <class F, class W, class O>
 void release_fields(F& f, W& w, O& o) {
-  f(w.motion_version), f(w.motion), f(w.config_version), f(w.config_refit), f(w.config), f(w.config_counters);
+  f(w.motion_version), f(w.config_version), f(w.config_refit), f(w.config_counters);
   f(o.episode), f(o.start), f(o.rng), f(o.motion_rng), f(o.set_motion_counters), f(o.motion_counters);
   f(o.set_config_rng), f(o.config_rng);
 }
@@ -397,15 +398,21 @@ void rollout_from_bytes(const std::vector<char>& bytes, Rollout& r) {
   if (r.ended) episode_log_fields(f, r.log);
 }
 
-void release_to_bytes(const ActingWeights& w, const Orders& o, std::vector<char>& bytes) {
+void release_to_bytes(const ActingWeights& w, const Orders& o, bool motion_weights, bool config_weights,
+                      std::vector<char>& bytes) {
+  static const std::vector<float> none;
   bytes.clear();
   Put f{{bytes}};
   release_fields(f, w, o);
+  f(motion_weights ? w.motion : none), f(config_weights ? w.config : none);
 }
 
+// An empty buffer stands for the version the actor holds (Actor::take reads
+// the buffers only for a new version).
 void release_from_bytes(const std::vector<char>& bytes, ActingWeights& w, Orders& o) {
   Get f{{bytes}};
   release_fields(f, w, o);
+  f(w.motion), f(w.config);
 }
 
 }  // namespace comorph::coopt

@@ -140,7 +140,10 @@ struct Orders {
 // transitions (Rollout::transitions preallocated) and weights.
 void rollout_to_bytes(const Rollout& r, std::vector<char>& bytes);
 void rollout_from_bytes(const std::vector<char>& bytes, Rollout& r);
-void release_to_bytes(const ActingWeights& w, const Orders& o, std::vector<char>& bytes);
+// Without motion_weights (config_weights) the motion (config) weights go as
+// an empty buffer: for an actor that holds their version already.
+void release_to_bytes(const ActingWeights& w, const Orders& o, bool motion_weights, bool config_weights,
+                      std::vector<char>& bytes);
 void release_from_bytes(const std::vector<char>& bytes, ActingWeights& w, Orders& o);
 
 // The most transitions one round of one actor can hand over: an interval

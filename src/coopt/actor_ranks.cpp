@@ -94,6 +94,8 @@ int mpi_actor_ranks() {
 
 ActorRanks::ActorRanks(const CooptConfig& c) : received_(static_cast<std::size_t>(mpi_actor_ranks())) {
   rollouts_.assign(received_.size(), nullptr);
+  motion_version_.assign(received_.size(), 0);
+  config_version_.assign(received_.size(), 0);
   const int most = most_round_transitions(c.trainer, actors());
   for (Rollout& r : received_) allocate_transitions(c, r.transitions, static_cast<std::size_t>(most));
 }
@@ -104,9 +106,13 @@ ActorRanks::~ActorRanks() {
 }
 
 std::vector<Rollout*>& ActorRanks::round(const ActingWeights& weights, const std::vector<Orders>& orders) {
-  for (int i = 0; i < actors(); ++i) {
-    release_to_bytes(weights, orders[static_cast<std::size_t>(i)], bytes_);
-    send(bytes_, i + 1, kRelease);
+  for (std::size_t i = 0; i < received_.size(); ++i) {
+    const bool motion = motion_version_[i] != weights.motion_version;
+    const bool config = config_version_[i] != weights.config_version;
+    release_to_bytes(weights, orders[i], motion, config, bytes_);
+    send(bytes_, static_cast<int>(i) + 1, kRelease);
+    motion_version_[i] = weights.motion_version;
+    config_version_[i] = weights.config_version;
   }
   for (int i = 0; i < actors(); ++i) {
     rollouts_[static_cast<std::size_t>(i)] = nullptr;

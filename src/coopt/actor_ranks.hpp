@@ -29,6 +29,8 @@ class ActorRanks final : public ActorTransport {
 
  private:
   std::vector<Rollout> received_;  // by actor, preallocated
+  // The weights' versions each actor holds: it is sent only newer ones.
+  std::vector<std::uint64_t> motion_version_, config_version_;
   std::vector<Rollout*> rollouts_;
   std::vector<char> bytes_;
 };

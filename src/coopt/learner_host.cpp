@@ -57,9 +57,14 @@ void LearnerHost::resume() {
   run_files_ = true;
 }
 
+// The weights change only in updates: unchanged ones keep their version, and
+// an actor that holds it copies nothing (the refit's frozen motion model).
 void LearnerHost::refresh_motion() {
+  const std::int64_t updates = state_.motion->counters().updates;
+  if (weights_.motion_version > 0 && updates == motion_updates_) return;
   rl::acting_weights(*state_.motion, weights_.motion);
   ++weights_.motion_version;
+  motion_updates_ = updates;
 }
 
 void LearnerHost::refresh_config() {
