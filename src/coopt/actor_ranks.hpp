@@ -3,7 +3,7 @@
 // A round: the host sends each actor rank the weights and its orders as one
 // message, then receives the rollout of each actor with an episode, in actor
 // order (the values as bytes: rollout_to_bytes, release_to_bytes). Waiting
-// polls with short sleeps, so a waiting rank leaves its core to the others.
+// polls with growing sleeps, so a waiting rank leaves its core to the others.
 // Internal to coopt; the public face is coopt/trainer.hpp (MpiJob,
 // ActorPlacement, serve_actor_rank).
 #pragma once
