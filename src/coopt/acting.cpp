@@ -168,7 +168,7 @@ void Actor::hand_over(ActorLink& link) {
 }
 
 void Actor::serve(ActorLink& link) {
-  const Rollout* out = nullptr;
+  Rollout* out = nullptr;
   try {
     while (true) {
       const ActingWeights* weights = nullptr;

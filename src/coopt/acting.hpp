@@ -159,9 +159,10 @@ class ActorLink {
  public:
   virtual ~ActorLink() = default;
   // Hands `rollout` over (nullptr: the actor had no episode and arrives with
-  // nothing) and waits for the next round's weights and orders, which stay
-  // valid until the next exchange. Throws ActorStopped when the run ends.
-  virtual void exchange(const Rollout* rollout, const ActingWeights*& weights, const Orders*& orders) = 0;
+  // nothing; the host may move out of it) and waits for the next round's
+  // weights and orders, which stay valid until the next exchange. Throws
+  // ActorStopped when the run ends.
+  virtual void exchange(Rollout* rollout, const ActingWeights*& weights, const Orders*& orders) = 0;
 };
 
 // The host's side of a transport.

@@ -49,7 +49,7 @@ void send(const std::vector<char>& bytes, int dest, int tag) {
 // An actor rank's side: the host is rank 0.
 class RankLink final : public ActorLink {
  public:
-  void exchange(const Rollout* rollout, const ActingWeights*& weights, const Orders*& orders) override {
+  void exchange(Rollout* rollout, const ActingWeights*& weights, const Orders*& orders) override {
     if (rollout) {
       rollout_to_bytes(*rollout, bytes_);
       send(bytes_, 0, kRollout);

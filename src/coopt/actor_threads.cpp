@@ -7,11 +7,11 @@ namespace comorph::coopt {
 class ActorThreads::Link final : public ActorLink {
  public:
   Link(ActorThreads& threads, int index) : threads_(threads), index_(index) {}
-  void exchange(const Rollout* rollout, const ActingWeights*& weights, const Orders*& orders) override {
+  void exchange(Rollout* rollout, const ActingWeights*& weights, const Orders*& orders) override {
     ActorThreads& t = threads_;
     std::unique_lock<std::mutex> lock(t.mutex_);
     if (rollout) {
-      t.rollouts_[static_cast<std::size_t>(index_)] = const_cast<Rollout*>(rollout);
+      t.rollouts_[static_cast<std::size_t>(index_)] = rollout;
       ++t.arrived_;
       t.cv_.notify_all();
     }
