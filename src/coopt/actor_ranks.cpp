@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "rl/learner.hpp"
+
 namespace comorph::coopt {
 namespace {
 
@@ -133,6 +135,7 @@ std::vector<Rollout*>& ActorRanks::round(const ActingWeights& weights, const std
 }
 
 void serve_actor_rank(const CooptConfig& config) {
+  rl::set_torch_threads(config.trainer.torch_threads, 1);  // as the host's process sets its own (TrainingState)
   Actor actor(config, mpi_actor_ranks(), {});
   RankLink link;
   actor.serve(link);
