@@ -157,6 +157,7 @@ void Actor::take(const ActingWeights& weights, const Orders& orders) {
 void Actor::hand_over(ActorLink& link) {
   laps.lap(kHandover);
   if (agent_.config) rollout_.config_rng = agent_.config->rng();
+  rollout_.actor_time = laps.spent;
   const ActingWeights* weights = nullptr;
   const Orders* orders = nullptr;
   link.exchange(&rollout_, weights, orders);
@@ -266,6 +267,7 @@ void Actor::play(int episode, ActorLink& link) {
   rollout_.motion_counters = agent_.motion->counters();
   if (agent_.config) rollout_.config_rng = agent_.config->rng();
   laps.lap(kOther);
+  rollout_.actor_time = laps.spent;
 }
 
 namespace {
@@ -355,7 +357,7 @@ void episode_log_fields(F& f, L& l) {
 template <class F, class R>
 void rollout_head_fields(F& f, R& r) {
   f(r.stored), f(r.steps), f(r.decision_logs), f(r.ended), f(r.rng), f(r.motion_rng), f(r.config_rng);
-  f(r.motion_counters);
+  f(r.motion_counters), f(r.actor_time);
 }
 
 // A release: these, then the two weight buffers.

@@ -105,6 +105,9 @@ struct Rollout {
   // are now: one actor's host keeps them (checkpoints, the next episode).
   std::mt19937_64 rng, motion_rng, config_rng;
   rl::LearnerCounters motion_counters;
+  // The actor's time so far (its Laps): a transport between processes
+  // reports it from here (TrainerTiming).
+  std::array<Clock::duration, kPhases> actor_time{};
   void clear() {
     stored = steps = 0;
     decisions.clear();

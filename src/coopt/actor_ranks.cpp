@@ -134,6 +134,13 @@ std::vector<Rollout*>& ActorRanks::round(const ActingWeights& weights, const std
   return rollouts_;
 }
 
+std::array<Clock::duration, kPhases> ActorRanks::actor_time() const {
+  std::array<Clock::duration, kPhases> spent{};
+  for (const Rollout& r : received_)
+    for (int p = 0; p < kPhases; ++p) spent[p] += r.actor_time[p];
+  return spent;
+}
+
 void serve_actor_rank(const CooptConfig& config) {
   rl::set_torch_threads(config.trainer.torch_threads, 1);  // as the host's process sets its own (TrainingState)
   Actor actor(config, mpi_actor_ranks(), {});

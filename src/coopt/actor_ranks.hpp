@@ -24,8 +24,8 @@ class ActorRanks final : public ActorTransport {
   ~ActorRanks() override;  // tells every actor rank that the run ended
   int actors() const override { return static_cast<int>(rollouts_.size()); }
   std::vector<Rollout*>& round(const ActingWeights& weights, const std::vector<Orders>& orders) override;
-  // The actors' laps stay on their ranks: zeros here.
-  std::array<Clock::duration, kPhases> actor_time() const override { return {}; }
+  // As of each actor's latest rollout.
+  std::array<Clock::duration, kPhases> actor_time() const override;
 
  private:
   std::vector<Rollout> received_;  // by actor, preallocated
