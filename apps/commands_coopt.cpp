@@ -39,7 +39,9 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
       mpi.abort(1);
     }
     if (finished) return;
-    std::fprintf(stderr, "continue with: comorph train --resume %s\n", (resume.empty() ? out : resume).c_str());
+    const std::string launcher = mpi.joined() ? "mpirun -np " + std::to_string(mpi.size()) + " " : "";
+    std::fprintf(stderr, "continue with: %scomorph train --resume %s\n", launcher.c_str(),
+                 (resume.empty() ? out : resume).c_str());
     std::fflush(stderr);
     std::exit(130);  // interrupted: a calling script (make run) stops here too
   });
