@@ -3,9 +3,9 @@
 // decision and episode logs); the learner host (coopt/learner_host.hpp)
 // consumes them and sends back the acting weights as bytes, with each actor's
 // orders (its episode, random streams, schedule clocks). One loop drives both
-// (Trainer::run, coopt/trainer.cpp); a transport carries the values between
-// them: threads of one process (coopt/actor_threads.hpp) for one actor or
-// several. Internal to coopt.
+// (act_and_learn, coopt/learner_host.hpp); a transport carries the values
+// between them: threads of one process (coopt/actor_threads.hpp), or the
+// ranks of an MPI job (coopt/actor_ranks.hpp). Internal to coopt.
 //
 //   actor i                              learner host
 //   ------------------------------       ------------------------------------

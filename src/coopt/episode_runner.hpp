@@ -34,7 +34,7 @@ namespace comorph::coopt {
 
 using Clock = std::chrono::steady_clock;
 
-// Where the acting thread's time goes (TrainerTiming): each lap() gives the
+// Where an actor's (or the host's) time goes (TrainerTiming): each lap() gives the
 // time since the previous one to a phase, so every moment counts once. One
 // steady_clock read a lap and fixed storage: cheap enough for every control
 // step (~20 ns against a step of ~0.3 ms), and it never touches the results.
