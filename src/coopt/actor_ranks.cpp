@@ -23,9 +23,10 @@ void check(int code, const char* what) {
 
 // Waits for a message from `source` (any tag) without spinning on the core
 // (MPI's blocking receive polls it at 100 %): sleeps from 20 us, doubling
-// to 1 ms, so a long wait costs a wake-up a millisecond and a short one
-// little latency.
-MPI_Status wait_for_message(int source) {
+// up to `longest`. The host waits a whole round for rollouts (1 ms: a
+// wake-up a millisecond); an actor waits while the host closes the round,
+// and its wake-up delays the next round (200 us).
+MPI_Status wait_for_message(int source, std::chrono::microseconds longest) {
   MPI_Status status;
   int arrived = 0;
   auto nap = std::chrono::microseconds(20);
@@ -33,7 +34,7 @@ MPI_Status wait_for_message(int source) {
     check(MPI_Iprobe(source, MPI_ANY_TAG, MPI_COMM_WORLD, &arrived, &status), "MPI_Iprobe");
     if (arrived) return status;
     std::this_thread::sleep_for(nap);
-    nap = std::min(2 * nap, std::chrono::microseconds(1000));
+    nap = std::min(2 * nap, longest);
   }
 }
 
@@ -56,7 +57,7 @@ class RankLink final : public ActorLink {
       rollout_to_bytes(*rollout, bytes_);
       send(bytes_, 0, kRollout);
     }
-    const MPI_Status status = wait_for_message(0);
+    const MPI_Status status = wait_for_message(0, std::chrono::microseconds(200));
     receive(0, status, bytes_);
     if (status.MPI_TAG == kStop) throw ActorStopped{};
     release_from_bytes(bytes_, weights_, orders_);
@@ -103,6 +104,8 @@ int mpi_actor_ranks() {
 ActorRanks::ActorRanks(const CooptConfig& c) : received_(static_cast<std::size_t>(mpi_actor_ranks())) {
   rollouts_.assign(received_.size(), nullptr);
   motion_version_.assign(received_.size(), 0);
+  releases_.resize(received_.size());
+  sends_.resize(received_.size());
   config_version_.assign(received_.size(), 0);
   const int most = most_round_transitions(c.trainer, actors());
   for (Rollout& r : received_) allocate_transitions(c, r.transitions, static_cast<std::size_t>(most));
@@ -114,23 +117,29 @@ ActorRanks::~ActorRanks() {
 }
 
 std::vector<Rollout*>& ActorRanks::round(const ActingWeights& weights, const std::vector<Orders>& orders) {
+  // All releases at once: each actor takes its own as soon as it wakes, not
+  // after the one before it.
   for (std::size_t i = 0; i < received_.size(); ++i) {
     const bool motion = motion_version_[i] != weights.motion_version;
     const bool config = config_version_[i] != weights.config_version;
-    release_to_bytes(weights, orders[i], motion, config, bytes_);
-    send(bytes_, static_cast<int>(i) + 1, kRelease);
+    release_to_bytes(weights, orders[i], motion, config, releases_[i]);
+    check(MPI_Isend(releases_[i].data(), static_cast<int>(releases_[i].size()), MPI_BYTE, static_cast<int>(i) + 1,
+                    kRelease, MPI_COMM_WORLD, &sends_[i]),
+          "MPI_Isend");
     motion_version_[i] = weights.motion_version;
     config_version_[i] = weights.config_version;
   }
   for (int i = 0; i < actors(); ++i) {
     rollouts_[static_cast<std::size_t>(i)] = nullptr;
     if (orders[static_cast<std::size_t>(i)].episode < 0) continue;
-    const MPI_Status status = wait_for_message(i + 1);
+    const MPI_Status status = wait_for_message(i + 1, std::chrono::microseconds(1000));
     receive(i + 1, status, bytes_);
     Rollout& r = received_[static_cast<std::size_t>(i)];
     rollout_from_bytes(bytes_, r);
     rollouts_[static_cast<std::size_t>(i)] = &r;
   }
+  // Done by now (the probes above moved them on): the buffers are free again.
+  check(MPI_Waitall(static_cast<int>(sends_.size()), sends_.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
   return rollouts_;
 }
 

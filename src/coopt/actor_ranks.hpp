@@ -8,6 +8,8 @@
 // ActorPlacement, serve_actor_rank).
 #pragma once
 
+#include <mpi.h>
+
 #include <vector>
 
 #include "coopt/acting.hpp"
@@ -33,6 +35,8 @@ class ActorRanks final : public ActorTransport {
   std::vector<std::uint64_t> motion_version_, config_version_;
   std::vector<Rollout*> rollouts_;
   std::vector<char> bytes_;
+  std::vector<std::vector<char>> releases_;  // by actor: in flight until every send is done
+  std::vector<MPI_Request> sends_;
 };
 
 }  // namespace comorph::coopt
