@@ -43,12 +43,12 @@ case $case in
     job=$!
     # Row 3 follows the checkpoint after episode 2: a resume has a checkpoint.
     rows=0
-    for _ in $(seq 600); do
+    for _ in $(seq 2400); do
       rows=$(rows_of "$work/killed/episodes.csv")
       [ "$rows" -ge 3 ] && break
       sleep 0.05
     done
-    [ "$rows" -ge 3 ] || fail "the ranks' run wrote no 3 episodes in 30 s"
+    [ "$rows" -ge 3 ] || fail "the ranks' run wrote no 3 episodes in 120 s"
     actor=
     for pid in $(pgrep -f -- "--out $work/killed"); do
       tr '\0' '\n' < "/proc/$pid/environ" 2> /dev/null | grep -qx OMPI_COMM_WORLD_RANK=1 && actor=$pid
