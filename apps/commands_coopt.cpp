@@ -10,6 +10,7 @@
 #include "cli_scenario.hpp"
 #include "morphology/configuration.hpp"
 #include "command_registry.hpp"
+#include "coopt/trainer.hpp"
 #include "workflows/run_steps.hpp"
 
 namespace {
@@ -23,8 +24,24 @@ comorph::cli::CommandRegistration registration{[](CLI::App& app) {
   tr->add_option("--out", out, "new run directory, e.g. runs/quick");
   tr->add_option("--resume", resume, "continue the run in this directory from its last checkpoint");
   tr->callback([] {
-    if (comorph::workflows::train_run(config, sets, out, resume)) return;
-    std::fprintf(stderr, "continue with: comorph train --resume %s\n", (resume.empty() ? out : resume).c_str());
+    // Under `mpirun -np K`: rank 0 trains, ranks 1..K-1 are its actors.
+    const comorph::coopt::MpiJob mpi;
+    bool finished = true;
+    try {
+      if (mpi.rank() > 0) {
+        comorph::workflows::serve_train_actor(config, sets, resume);
+        return;
+      }
+      finished = comorph::workflows::train_run(config, sets, out, resume, false, mpi.joined());
+    } catch (const std::exception& e) {
+      if (!mpi.joined()) throw;
+      std::fprintf(stderr, "comorph: error on rank %d of the MPI job: %s\n", mpi.rank(), e.what());
+      mpi.abort(1);
+    }
+    if (finished) return;
+    const std::string launcher = mpi.joined() ? "mpirun -np " + std::to_string(mpi.size()) + " " : "";
+    std::fprintf(stderr, "continue with: %scomorph train --resume %s\n", launcher.c_str(),
+                 (resume.empty() ? out : resume).c_str());
     std::fflush(stderr);
     std::exit(130);  // interrupted: a calling script (make run) stops here too
   });

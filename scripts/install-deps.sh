@@ -15,6 +15,7 @@ packages=(
   ffmpeg gnuplot-nox                                # video, plots
   pybind11-dev python3-dev python3-numpy python3-pytest  # the Python module and its tests (docs/python.md)
   python3-torch                                     # examples/train_reinforce.py (its test skips without it)
+  mpi-default-dev openmpi-bin                       # OpenMPI: the trainer's actors on MPI ranks (mpirun)
   parallel slurm-wlm munge                          # engines of `comorph experiment --jobs/--slurm` (tests: scripts/slurm-local.sh)
 )
 

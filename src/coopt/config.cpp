@@ -83,7 +83,8 @@ void add_fields(YamlFields& f, TrainerParams& p) {
   f.add("learner_thread", &p.learner_thread, "run the motion updates on a second thread (same results as inline)");
   f.add("torch_threads", &p.torch_threads, 1, 64, "torch intra-op threads per thread");
   f.add("simulation_threads", &p.simulation_threads, 1, 64,
-        "threads simulating episodes for the one learner (a seed repeats its numbers for a given count)");
+        "actor threads simulating episodes for the one learner (a seed repeats its numbers for a given count; under "
+        "mpirun the other ranks are the actors)");
   f.add("motion_image", &p.motion_image, "the motion model sees the depth image (CNN) beside the state");
   f.add("config_vector", &p.config_vector, "the DQN sees [C_n / 10, scene one-hot] beside its image");
   f.add("motion_clearance", &p.motion_clearance,

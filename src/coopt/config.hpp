@@ -73,15 +73,16 @@ struct TrainerParams {
   int episodes = 4000;                // training episodes after the warm-up
   // Motion-model updates run on a learner thread, overlapped with the
   // simulation: every `sync_interval` control steps (and at every episode end)
-  // the acting thread hands its transitions over, waits for the previous
-  // batch of updates and copies the new actor weights. The schedule does not
-  // depend on timing, so both thread modes give identical results.
+  // the actor hands its transitions over, waits for the previous batch of
+  // updates and takes the new actor weights (coopt/acting.hpp). The schedule
+  // does not depend on timing, so both thread modes give identical results.
   int sync_interval = 64;             // control steps between hand-overs (the acting policy lags by <= 2 of these)
   bool learner_thread = true;         // false: run the updates inline (one core, same results)
   int torch_threads = 1;              // torch intra-op threads per thread (1: small nets, reproducible)
-  // Simulation threads, each with its own env, scene source, pilot and acting
-  // copies of both models, feeding the one learner (coopt/simulation_threads.cpp).
-  // 1: the single acting thread above. N > 1: they step in rounds of equal
+  // Actors on threads, each with its own env, scene source, pilot and acting
+  // copies of both models, feeding the one learner host (coopt/acting.hpp;
+  // under mpirun the job's other ranks are the actors instead).
+  // 1: the single actor above. N > 1: they step in rounds of equal
   // simulation work (sync_interval control steps of a 4-module chain; a
   // thread whose episode ends waits for the round's end), the round's
   // transitions and decisions go to the learner thread in thread order,

@@ -200,7 +200,7 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
   auto choose = [&](rl::Observation& o) -> const Configuration& {
     int a = hooks && hooks->random_config ? hooks->random_config(b.mask) : -1;
     if (a < 0) {
-      agent.choose_config(o, explore, b.caction);
+      agent.config->act(o, explore, b.caction);
       a = b.caction.discrete;
     }
     b.caction.discrete = a;

@@ -34,7 +34,7 @@ namespace comorph::coopt {
 
 using Clock = std::chrono::steady_clock;
 
-// Where the acting thread's time goes (TrainerTiming): each lap() gives the
+// Where an actor's (or the host's) time goes (TrainerTiming): each lap() gives the
 // time since the previous one to a phase, so every moment counts once. One
 // steady_clock read a lap and fixed storage: cheap enough for every control
 // step (~20 ns against a step of ~0.3 ms), and it never touches the results.
@@ -101,20 +101,12 @@ class SceneSource {
   std::unique_ptr<perception::SceneMonitor> monitor_;
 };
 
-// What acts in an episode: the motion model's policy and the configuration model.
+// What acts in an episode: acting copies (rl::Policy) of both models; their
+// learners live with the learner host (coopt/learner_host.hpp).
 struct Agent {
-  std::unique_ptr<rl::Policy> motion;    // acting side of the motion model
-  std::unique_ptr<rl::Learner> config;   // the DQN; nullptr in fixed mode
-  // A simulation thread's acting copy of the DQN (trainer.simulation_threads
-  // > 1), which acts instead of `config` (then nullptr) when set.
-  std::unique_ptr<rl::Policy> config_copy;
-  bool hierarchical() const { return config || config_copy; }
-  void choose_config(const rl::Observation& o, bool explore, rl::Action& a) {
-    if (config_copy)
-      config_copy->act(o, explore, a);
-    else
-      config->act(o, explore, a);
-  }
+  std::unique_ptr<rl::Policy> motion;  // the motion model
+  std::unique_ptr<rl::Policy> config;  // the configuration model (DQN); nullptr in fixed mode
+  bool hierarchical() const { return config != nullptr; }
 };
 
 // Training hooks of one episode (absent for evaluation).

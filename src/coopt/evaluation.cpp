@@ -35,7 +35,7 @@ CheckpointInfo open_checkpoint_for_evaluation(const CooptConfig& config, const s
 void load_greedy_agent(const CooptConfig& c, const CheckpointInfo& checkpoint, Agent& agent) {
   agent.motion = make_motion_policy(c, 1);
   load_learner_file(*agent.motion, (fs::path(checkpoint.directory) / "motion_actor.pt").string());
-  agent.config = make_config_model(c, 2);
+  agent.config = make_config_policy(c, false);
   if (agent.config) load_learner_file(*agent.config, (fs::path(checkpoint.directory) / "config_model.pt").string());
 }
 
@@ -120,7 +120,7 @@ std::uintmax_t export_policy(const CooptConfig& config, const std::string& run_d
   fs::create_directories(out_checkpoint_dir);
   const fs::path out(out_checkpoint_dir);
   player.agent.motion->save((out / "motion_actor.pt").string());
-  if (player.agent.config) player.agent.config->save_policy((out / "config_model.pt").string());
+  if (player.agent.config) player.agent.config->save((out / "config_model.pt").string());
   fs::copy_file(fs::path(info.directory) / "trainer.yaml", out / "trainer.yaml", fs::copy_options::overwrite_existing);
   std::vector<std::string> names{"motion_actor.pt", "trainer.yaml"};
   if (player.agent.config) names.push_back("config_model.pt");

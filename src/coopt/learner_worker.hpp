@@ -83,7 +83,7 @@ class LearnerWorker {
   std::exception_ptr error_;
 };
 
-// A transition as the acting thread hands it over (also a decision of the
+// A transition as an actor hands it over (also a decision of the
 // configuration model kept for the return target).
 struct Transition {
   rl::Observation obs, next;

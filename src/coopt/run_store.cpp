@@ -337,11 +337,10 @@ void RunStore::write_checkpoint_files(const TrainingState& s, const CooptConfig&
     motion_next = rl::write_replay_segments(s.motion->replay(), "motion", tmp, s.motion_segments, files, sums);
   }
   s.agent.motion->save((fs::path(tmp) / "motion_actor.pt").string());  // the acting side: networks, counters, RNG
-  if (s.agent.config) {
-    s.agent.config->save_without_replay((fs::path(tmp) / "config_model.pt").string());
+  if (s.config) {
+    s.config->save_without_replay((fs::path(tmp) / "config_model.pt").string());
     files.push_back("config_model.pt");
-    config_next =
-        rl::write_replay_segments(s.agent.config->replay(), "config_model", tmp, s.config_segments, files, sums);
+    config_next = rl::write_replay_segments(s.config->replay(), "config_model", tmp, s.config_segments, files, sums);
   }
   YAML::Emitter e;
   e << YAML::BeginMap;
@@ -371,11 +370,11 @@ void RunStore::load_checkpoint(TrainingState& s, const CooptConfig& config) cons
   load_learner_file(*s.motion, (fs::path(info.directory) / "motion.pt").string());
   if (!s.motion_on_policy) s.motion_segments = load_replay(*s.motion, "motion", info.directory);
   load_learner_file(*s.agent.motion, (fs::path(info.directory) / "motion_actor.pt").string());
-  if (s.agent.config) {
+  if (s.config) {
     // Inside the DQN refit the checkpoint holds the refit DQN: built with its own hyperparameters.
-    if (info.episodes > config.trainer.refit_start()) s.agent.config = make_refit_config_model(config);
-    load_learner_file(*s.agent.config, (fs::path(info.directory) / "config_model.pt").string());
-    s.config_segments = load_replay(*s.agent.config, "config_model", info.directory);
+    if (info.episodes > config.trainer.refit_start()) s.start_refit(config);
+    load_learner_file(*s.config, (fs::path(info.directory) / "config_model.pt").string());
+    s.config_segments = load_replay(*s.config, "config_model", info.directory);
   }
   const YAML::Node n = load_yaml_file((fs::path(info.directory) / "trainer.yaml").string());
   rl::set_rng_state(s.rng, n["rng"].as<std::string>());

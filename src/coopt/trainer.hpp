@@ -15,15 +15,16 @@
 //     DQN decides again among [2, C_n] (env.reconfigure sheds tail modules);
 //  4. at the episode end the last segment is stored (terminated/truncated).
 //
-// Both cores: the motion learner (full replay, optimizers) lives on a learner
-// thread; the acting thread runs the simulation with the motion model's
-// rl::Policy (a copy of the acting networks, the exploration schedule and its
-// own RNG). Every trainer.sync_interval control steps and at every episode
-// end the acting thread hands over its transitions, waits for the learner's
-// previous batch of updates and copies the new weights. The schedule is a
-// function of the step count only, so the threaded and the inline mode give
-// the same results for a seed (docs/coopt.md has the trade-off: the acting
-// policy lags the learner by one to two intervals).
+// Inside (coopt/acting.hpp): actors play the episodes with acting copies
+// (rl::Policy) of both models and hand their rollouts over as values; a
+// learner host holds both learners (the motion learner on a learner thread),
+// takes the rollouts in and sends the weights back as bytes. With one actor
+// that is one acting thread handing over every trainer.sync_interval control
+// steps and at every episode end; with trainer.simulation_threads > 1 the
+// actors step in lockstep rounds. The schedule is a function of the run
+// only, so the threaded and the inline learner give the same results for a
+// seed (docs/coopt.md has the trade-off: the acting policy lags the learner
+// by one to two intervals).
 #pragma once
 
 #include <atomic>
@@ -41,6 +42,9 @@ class MultiTaskEnv;  // task/multitask_env.hpp: what a StepObserver sees
 }
 
 namespace comorph::coopt {
+
+class LearnerHost;     // coopt/learner_host.hpp
+class ActorTransport;  // coopt/acting.hpp
 
 // One finished episode (training or evaluation): the report's episode record
 // (task::EpisodeRecord) plus what only the trainer knows.
@@ -115,15 +119,15 @@ void check_same_run(const CheckpointInfo& info, const CooptConfig& config, const
 void truncate_csv_rows(const std::string& path, int rows);
 
 // Where Trainer::run() spent its wall time, s, for bench/coopt/bench_trainer
-// (docs/coopt.md, "Throughput"). Every moment of the acting (calling) thread
+// (docs/coopt.md, "Throughput"). Every moment of an actor's thread
 // falls in exactly one of its fields (steady_clock laps, no allocation), so
-// they add up to wall_s; motion_updates_s is on that thread only without a
+// they add up to about wall_s; motion_updates_s is on the host's thread only without a
 // learner thread (trainer.learner_thread: false). learner_busy_s is the time
 // the learner spent in its jobs (store + updates), on whichever thread ran them.
-// With trainer.simulation_threads > 1 the fields are the mean over those
-// threads (their wait at a round's end in waiting_s), the trainer's own
-// thread's round closing, evaluations, checkpoints and logging taken out of
-// that wait into their fields, and learner_busy_s holds the DQN's jobs too.
+// The fields are the mean over the actors (their wait at a round's end in
+// waiting_s), with the host's ingesting, inline learning, evaluations,
+// checkpoints and logging taken out of that wait into their fields; with
+// several actors learner_busy_s holds the DQN's jobs too.
 struct TrainerTiming {
   double wall_s = 0;            // run() calls of this object, summed
   double env_step_s = 0;        // MultiTaskEnv::step
@@ -142,12 +146,44 @@ struct TrainerTiming {
   int checkpoints = 0;          // checkpoints written by run()
 };
 
+// This process's place in an MPI job that mpirun (OpenMPI) started: joined at
+// construction when the job has 2 ranks or more, left at destruction. Rank 0
+// trains with the other ranks as its actors (ActorPlacement::mpi_ranks); every
+// other rank serves as an actor (serve_actor_rank). Outside mpirun, or with
+// one rank, nothing happens.
+class MpiJob {
+ public:
+  MpiJob();
+  ~MpiJob();
+  MpiJob(const MpiJob&) = delete;
+  MpiJob& operator=(const MpiJob&) = delete;
+  bool joined() const { return size_ > 1; }
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  // Ends every rank of the job with `code` (after an error on this one).
+  void abort(int code) const;
+
+ private:
+  int rank_ = 0, size_ = 1;
+};
+
+// Where the trainer's actors run: trainer.simulation_threads threads of this
+// process, or the other ranks of the MPI job this process is rank 0 of (one
+// actor each; trainer.simulation_threads is then unused). The same seed and
+// number of actors give the same results either way.
+enum class ActorPlacement { threads, mpi_ranks };
+
+// An actor rank of an MPI job: plays what rank 0's trainer orders until that
+// trainer ends the run. `config` must be the run's.
+void serve_actor_rank(const CooptConfig& config);
+
 class Trainer {
  public:
   // run_dir must exist. The trainer writes, through coopt/run_store.hpp,
   // config.yaml, run.yaml, episodes.csv, evaluations.csv and checkpoint/
   // (`comorph eval` adds its files beside them).
-  Trainer(const CooptConfig& config, const std::string& run_dir, TrainerCallbacks callbacks = {});
+  Trainer(const CooptConfig& config, const std::string& run_dir, TrainerCallbacks callbacks = {},
+          ActorPlacement actors = ActorPlacement::threads);
   ~Trainer();
   // Loads run_dir's latest checkpoint; throws (naming the difference) when it
   // was written by another configuration. Truncates episodes.csv and
@@ -166,10 +202,9 @@ class Trainer {
   double wall_s() const;  // training wall time including resumed parts
   TrainerTiming timing() const;
 
-  struct Impl;
-
  private:
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<LearnerHost> host_;
+  std::unique_ptr<ActorTransport> actors_;
 };
 
 // Each side of the trainer alone, for bench/coopt/bench_trainer: the acting

@@ -6,35 +6,34 @@
 #include <random>
 #include <stdexcept>
 
+#include "coopt/actor_threads.hpp"
+#include "coopt/learner_host.hpp"
 #include "coopt/segment.hpp"
 #include "coopt/trainer.hpp"
-#include "coopt/trainer_impl.hpp"
 #include "rl/learner.hpp"
 
 namespace comorph::coopt {
 
 SideRates measure_side_rates(const CooptConfig& config, std::int64_t steps) {
   if (steps < 1) throw std::invalid_argument("measure_side_rates: steps must be >= 1");
-  Trainer::Impl m(config, "", {});
-  const TrainerParams& t = config.trainer;
-  const int total = t.total_episodes();
+  // One actor and a host that records its transitions instead of learning them.
+  LearnerHost host(config, "", {}, 1);
+  ActorThreads actor(config, 1, {});
   // The last episode may run past `steps` by up to a whole episode.
   std::vector<Transition> record;
   allocate_transitions(config, record, static_cast<std::size_t>(steps + config.env.task.max_steps + 1));
-  m.record = &record;
+  host.record_into(&record);
   SideRates rates;
   Clock::time_point start = Clock::now();
-  while (static_cast<std::int64_t>(m.recorded) < steps && m.state.episode < total) {
-    m.train_episode();
-    ++m.state.episode;
-  }
-  rates.acting_steps = static_cast<std::int64_t>(m.recorded);
+  act_and_learn(host, actor, [&] { return static_cast<std::int64_t>(host.recorded()) >= steps; });
+  const std::size_t recorded = host.recorded();
+  rates.acting_steps = static_cast<std::int64_t>(recorded);
   rates.acting_steps_per_s =
-      static_cast<double>(m.recorded) / std::chrono::duration<double>(Clock::now() - start).count();
+      static_cast<double>(recorded) / std::chrono::duration<double>(Clock::now() - start).count();
 
   // The learner alone on those transitions; its first updates start the clock
   // (before learning_starts a step costs only the store).
-  rl::Learner& l = *m.state.motion;
+  rl::Learner& l = *host.state().motion;
   std::size_t i = 0;
   bool learning = false;
   auto learn = [&](const Transition& tr) {
@@ -43,14 +42,14 @@ SideRates measure_side_rates(const CooptConfig& config, std::int64_t steps) {
     learning = learning || due > 0;
     for (; due > 0; --due) l.update();
   };
-  while (i < m.recorded && !learning) learn(record[i++]);
+  while (i < recorded && !learning) learn(record[i++]);
   if (!learning)
-    throw std::runtime_error("measure_side_rates: " + std::to_string(m.recorded) +
+    throw std::runtime_error("measure_side_rates: " + std::to_string(recorded) +
                              " control steps never reached the motion learner's learning_starts; give more steps");
   const std::size_t first_timed = i;
   start = Clock::now();
-  while (i < m.recorded) learn(record[i++]);
-  rates.learner_steps = static_cast<std::int64_t>(m.recorded - first_timed);
+  while (i < recorded) learn(record[i++]);
+  rates.learner_steps = static_cast<std::int64_t>(recorded - first_timed);
   const double learner_s = std::chrono::duration<double>(Clock::now() - start).count();
   rates.learner_steps_per_s = learner_s > 0 ? static_cast<double>(rates.learner_steps) / learner_s : 0.0;
   return rates;
@@ -58,7 +57,8 @@ SideRates measure_side_rates(const CooptConfig& config, std::int64_t steps) {
 
 CheckpointCost measure_checkpoint_cost(const CooptConfig& config, const std::string& run_dir,
                                        std::int64_t transitions, std::int64_t new_transitions) {
-  Trainer::Impl m(config, run_dir, {});
+  LearnerHost host(config, run_dir, {}, 1);
+  TrainingState& state = host.state();
   std::mt19937_64 rng(1);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   rl::Observation o, next, co, cnext;
@@ -74,26 +74,24 @@ CheckpointCost measure_checkpoint_cost(const CooptConfig& config, const std::str
     for (std::int64_t k = 0; k < n; ++k, ++stored) {
       for (float& x : o.vector) x = u(rng);
       for (float& x : o.image) x = u(rng);
-      m.state.motion->store(o, a, u(rng), next, false, false);
-      if (m.state.agent.config && stored % 600 == 0) {
+      state.motion->store(o, a, u(rng), next, false, false);
+      if (state.config && stored % 600 == 0) {
         for (float& x : co.image) x = u(rng);
         ca.discrete = static_cast<int>(stored / 600 % kCandidates);
-        m.state.agent.config->store(co, ca, u(rng), cnext, false, false, 300);
+        state.config->store(co, ca, u(rng), cnext, false, false, 300);
       }
     }
   };
   CheckpointCost cost;
   fill(transitions);
   Clock::time_point start = Clock::now();
-  m.save_checkpoint();
+  host.checkpoint();
   cost.first_s = std::chrono::duration<double>(Clock::now() - start).count();
   fill(new_transitions);
   start = Clock::now();
-  m.save_checkpoint();
+  host.checkpoint();
   cost.next_s = std::chrono::duration<double>(Clock::now() - start).count();
   return cost;
 }
-
-// ---------------------------------------------------------------------------
 
 }  // namespace comorph::coopt

@@ -65,7 +65,14 @@ TrainingState::TrainingState(const CooptConfig& c) : rng(c.trainer.seed * 7919UL
   motion_on_policy = rl::learner_entry(c.trainer.motion_algo).on_policy;
   agent.motion = make_motion_policy(c, seed + 1);
   agent.motion->sync_from(*motion);
-  agent.config = make_config_model(c, seed + 2);
+  config = make_config_model(c, seed + 2);
+  agent.config = make_config_policy(c, false);
+}
+
+void TrainingState::start_refit(const CooptConfig& c) {
+  config = make_refit_config_model(c);
+  agent.config = make_config_policy(c, true);
+  config_refit = true;
 }
 
 TrainingState::~TrainingState() = default;

@@ -1,6 +1,7 @@
-// Everything a checkpoint of the trainer holds, and nothing else: both models
-// (the motion model's learner and policy, the configuration model), the
-// trainer's RNG, its counters and the replay segments of the last checkpoint.
+// Everything a checkpoint of the trainer holds, and nothing else: both
+// learners, the acting side of a one-actor run (the motion policy's counters
+// and RNG, the actor's RNG), the counters and the replay segments of the last
+// checkpoint.
 // RunStore (coopt/run_store.hpp) writes and reads it. Internal to coopt.
 #pragma once
 
@@ -16,14 +17,23 @@ namespace comorph::coopt {
 
 struct TrainingState {
   // Built from the config: learner (seed), policy (seed + 1, synced from the
-  // learner), configuration model (seed + 2), in this order (each seeds torch).
+  // learner), configuration model (seed + 2) and its acting copy, in this
+  // order (each seeds torch).
   explicit TrainingState(const CooptConfig& c);
   ~TrainingState();
+  // The DQN refit's start (trainer.config_refit_episodes): a fresh
+  // configuration model with the dqn_refit: hyperparameters, and its copy.
+  void start_refit(const CooptConfig& c);
 
   std::unique_ptr<rl::Learner> motion;  // learner thread: replay, optimizers, targets
   bool motion_on_policy = false;        // its own file holds its rollout: no replay segments
-  Agent agent;                          // acting thread: the motion policy and the configuration model
-  std::mt19937_64 rng;                  // warm-up configuration choices, noise on the pilot's actions
+  std::unique_ptr<rl::Learner> config;  // the configuration model (DQN); nullptr in fixed mode
+  bool config_refit = false;            // `config` is the refit's
+  // The host's acting copies, for periodic evaluations and the checkpoint's
+  // motion_actor.pt. With one actor, agent.motion's counters and RNG are the
+  // actor's at its last episode end (the actor continues them).
+  Agent agent;
+  std::mt19937_64 rng;                  // one actor: warm-up configuration choices, noise on the pilot's actions
   int episode = 0;                      // training episodes done (= rows of episodes.csv)
   int evaluations = 0;                  // periodic evaluations done (= rows of evaluations.csv)
   std::int64_t steps = 0;               // training control steps
@@ -42,8 +52,8 @@ std::unique_ptr<rl::Learner> make_motion_learner(const CooptConfig& c, std::uint
 std::unique_ptr<rl::Policy> make_motion_policy(const CooptConfig& c, std::uint64_t seed);
 std::unique_ptr<rl::Learner> make_config_model(const CooptConfig& c, std::uint64_t seed);
 std::unique_ptr<rl::Learner> make_refit_config_model(const CooptConfig& c);
-// An acting copy of the configuration model (or of the refit one), for a
-// simulation thread: its weights, counters and RNG are set by the trainer.
+// An acting copy of the configuration model (or of the refit one): its
+// weights, counters and RNG are set by the learner host.
 std::unique_ptr<rl::Policy> make_config_policy(const CooptConfig& c, bool refit);
 
 }  // namespace comorph::coopt

@@ -84,6 +84,13 @@ class Learner {
   virtual const torch::nn::Module& acting_networks() const = 0;
   // Loss of the latest update() (critic / Q loss), for logs.
   virtual double last_loss() const = 0;
+  // The RNG that act() and update() draw from, as a value: an acting copy
+  // (rl::Policy) that continues this stream is handed it and hands it back
+  // (coopt's one-actor schedule). Learners that cannot say so throw.
+  virtual const std::mt19937_64& rng() const { throw std::logic_error("this learner has no RNG to hand out"); }
+  virtual void set_rng(const std::mt19937_64& /*rng*/) {
+    throw std::logic_error("this learner has no RNG to take back");
+  }
 };
 
 // Linear interpolation from `start` to `end` over `duration` units, then `end`.

@@ -88,6 +88,8 @@ class OffPolicyLearner : public Learner {
   const LearnerCounters& counters() const final { return counters_; }
   const torch::nn::Module& acting_networks() const final { return acting_module(); }
   double last_loss() const final { return last_loss_; }
+  const std::mt19937_64& rng() const final { return rng_; }
+  void set_rng(const std::mt19937_64& rng) final { rng_ = rng; }
 
  protected:
   // What every off-policy config has (DqnConfig, Td3Config, SacConfig).

@@ -2,11 +2,39 @@
 
 #include <torch/torch.h>
 
+#include <algorithm>
+#include <stdexcept>
+
 #include "rl/networks.hpp"
 
 namespace comorph::rl {
 
 void Policy::sync_from(const Learner& learner) { copy_parameters(acting_module(), learner.acting_networks()); }
+
+void acting_weights(const Learner& learner, std::vector<float>& weights) {
+  const auto parameters = learner.acting_networks().parameters();
+  std::size_t size = 0;
+  for (const torch::Tensor& p : parameters) size += static_cast<std::size_t>(p.numel());
+  weights.resize(size);
+  std::size_t at = 0;
+  for (const torch::Tensor& p : parameters) {
+    const torch::Tensor c = p.detach().to(torch::kCPU).contiguous();
+    std::copy(c.data_ptr<float>(), c.data_ptr<float>() + c.numel(), weights.data() + at);
+    at += static_cast<std::size_t>(c.numel());
+  }
+}
+
+void Policy::load_weights(const std::vector<float>& weights) {
+  torch::NoGradGuard no_grad;
+  std::size_t at = 0;
+  for (torch::Tensor& p : acting_module().parameters()) {
+    const auto n = static_cast<std::size_t>(p.numel());
+    if (at + n > weights.size()) throw std::logic_error("Policy::load_weights: fewer weights than parameters");
+    p.copy_(torch::from_blob(const_cast<float*>(weights.data() + at), p.sizes(), torch::kFloat32));
+    at += n;
+  }
+  if (at != weights.size()) throw std::logic_error("Policy::load_weights: more weights than parameters");
+}
 
 void Policy::save(const std::string& path) const {
   save_policy_file(path, acting_module(), key_, counters_, rng_, algorithm_);

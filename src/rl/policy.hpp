@@ -41,6 +41,9 @@ class Policy {
   }
   // Copies the learner's acting networks (Learner::acting_networks) into this copy.
   void sync_from(const Learner& learner);
+  // The same from acting_weights()' buffer (an acting copy in another thread
+  // or process is sent these bytes).
+  void load_weights(const std::vector<float>& weights);
   // Networks, counters and RNG, in Learner::save_policy's format; load() also
   // reads a learner's full checkpoint (its networks, counters and RNG).
   void save(const std::string& path) const;
@@ -51,6 +54,13 @@ class Policy {
   void set_counters(const LearnerCounters& counters) { counters_ = counters; }
   void reseed(std::uint64_t seed) {
     rng_.seed(seed);
+    noise_.clear();
+  }
+  // The RNG as a value: an acting copy that continues another's random stream
+  // (coopt's one-actor schedule) is handed it and hands it back.
+  const std::mt19937_64& rng() const { return rng_; }
+  void set_rng(const std::mt19937_64& rng) {
+    rng_ = rng;
     noise_.clear();
   }
 
@@ -71,6 +81,10 @@ class Policy {
  private:
   std::string algorithm_, key_, device_;
 };
+
+// The learner's acting networks' parameters, in their order, as one flat
+// buffer (resized once: no allocation at later calls): what Policy::load_weights reads.
+void acting_weights(const Learner& learner, std::vector<float>& weights);
 
 // The policy of DQN, TD3 and SAC: a copy of the learner's acting network
 // (Net: QNetwork, ActorCritic) and the algorithm's acting rule, the same

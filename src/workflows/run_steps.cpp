@@ -63,8 +63,16 @@ void clear_run_dir(const std::string& dir) {
     if (!kept_before_training(entry.path())) fs::remove_all(entry.path());
 }
 
+void serve_train_actor(const std::string& config_path, const std::vector<std::string>& sets,
+                       const std::string& resume) {
+  const CooptConfig config = resume.empty()
+                                 ? comorph::coopt::load_coopt_config(config_path, sets)
+                                 : comorph::coopt::load_coopt_config((fs::path(resume) / "config.yaml").string());
+  comorph::coopt::serve_actor_rank(config);
+}
+
 bool train_run(const std::string& config_path, const std::vector<std::string>& sets, const std::string& out,
-               const std::string& resume, bool locked_by_caller) {
+               const std::string& resume, bool locked_by_caller, bool mpi_actors) {
   std::string run_dir;
   CooptConfig config;
   std::unique_ptr<RunLock> lock;  // one writer per run directory, for the whole training
@@ -88,7 +96,9 @@ bool train_run(const std::string& config_path, const std::vector<std::string>& s
     run_dir = out;
   }
   // Everything that can fail on bad input happens before the directory exists.
-  comorph::coopt::Trainer trainer(config, run_dir);
+  comorph::coopt::Trainer trainer(config, run_dir, {},
+                                  mpi_actors ? comorph::coopt::ActorPlacement::mpi_ranks
+                                             : comorph::coopt::ActorPlacement::threads);
 
   if (resume.empty()) {
     fs::create_directories(run_dir);

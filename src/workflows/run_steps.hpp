@@ -18,8 +18,15 @@ namespace comorph::workflows {
 // for the whole training unless `locked_by_caller` (`comorph experiment`
 // holds the column's lock itself). A resume is refused when episodes.csv or
 // evaluations.csv lack rows the checkpoint counts or have damaged ones.
+// mpi_actors: this process is rank 0 of an MPI job (coopt::MpiJob) and the
+// other ranks are its actors (each running serve_train_actor).
 bool train_run(const std::string& config_path, const std::vector<std::string>& sets, const std::string& out,
-               const std::string& resume, bool locked_by_caller = false);
+               const std::string& resume, bool locked_by_caller = false, bool mpi_actors = false);
+// An actor rank of `comorph train` under mpirun: the run's config from the
+// same arguments as rank 0's (config file + `--set`s, or the resumed run's
+// config.yaml), then coopt::serve_actor_rank until rank 0 ends the run.
+void serve_train_actor(const std::string& config_path, const std::vector<std::string>& sets,
+                       const std::string& resume);
 
 // The log a job of `comorph experiment --jobs/--slurm` appends to in its run
 // directory: like the lock file, there before the training starts.
