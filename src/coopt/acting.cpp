@@ -216,9 +216,10 @@ void Actor::play(int episode, ActorLink& link) {
     if (round_cost_ >= round_quota(config_.trainer) && !done) hand_over(link);
   };
   hooks.motion_greedy = plan.greedy_motion;
-  hooks.config = [this, &link, episode, learns = plan.config_learns](const rl::Observation& o, const rl::Action& a,
-                                                                     float r2, const rl::Observation& n, bool term,
-                                                                     bool trunc, int k) {
+  const double config_gamma = config_model_params(config_, plan.refit).gamma;  // the refit's own in the refit
+  hooks.config = [this, &link, episode, learns = plan.config_learns, config_gamma](
+                     const rl::Observation& o, const rl::Action& a, float r2, const rl::Observation& n, bool term,
+                     bool trunc, int k) {
     if (!learns) return;
     bool stored = false;
     if (config_.trainer.config_target == ConfigTarget::episode_return) {
@@ -228,7 +229,7 @@ void Actor::play(int episode, ActorLink& link) {
       d.action = a;
       episode_decision_returns_.push_back(r2);
       if (term || trunc) {
-        to_return_transitions(episode_decisions_, episode_decision_returns_, config_.dqn.gamma);
+        to_return_transitions(episode_decisions_, episode_decision_returns_, config_gamma);
         for (Transition& d : episode_decisions_) rollout_.decisions.push_back({std::move(d), 1});
         episode_decisions_.clear();
         stored = true;

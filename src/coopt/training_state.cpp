@@ -47,8 +47,10 @@ std::unique_ptr<rl::Learner> make_dqn(const CooptConfig& c, std::uint64_t seed, 
 
 std::unique_ptr<rl::Policy> make_config_policy(const CooptConfig& c, bool refit) {
   if (c.trainer.mode != TrainerMode::hierarchical) return nullptr;
-  return rl::make_policy("dqn", dqn_args(c, 0, refit ? c.dqn_refit : c.dqn));
+  return rl::make_policy("dqn", dqn_args(c, 0, config_model_params(c, refit)));
 }
+
+const rl::DqnConfig& config_model_params(const CooptConfig& c, bool refit) { return refit ? c.dqn_refit : c.dqn; }
 
 std::unique_ptr<rl::Learner> make_config_model(const CooptConfig& c, std::uint64_t seed) {
   return make_dqn(c, seed, c.dqn);

@@ -55,5 +55,7 @@ std::unique_ptr<rl::Learner> make_refit_config_model(const CooptConfig& c);
 // An acting copy of the configuration model (or of the refit one): its
 // weights, counters and RNG are set by the learner host.
 std::unique_ptr<rl::Policy> make_config_policy(const CooptConfig& c, bool refit);
+// The hyperparameters of the configuration model that learns: the refit's (dqn_refit:) in the refit.
+const rl::DqnConfig& config_model_params(const CooptConfig& c, bool refit);
 
 }  // namespace comorph::coopt

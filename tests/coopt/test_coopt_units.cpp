@@ -12,6 +12,7 @@
 #include "coopt/config.hpp"
 #include "coopt/config_reference.hpp"
 #include "coopt/segment.hpp"
+#include "coopt/training_state.hpp"
 #include "report/run_dir.hpp"
 #include "support/test_support.hpp"
 #include "task/rewards.hpp"
@@ -251,6 +252,11 @@ TEST(CooptConfig, DqnRefitOverlaysTheDqnSection) {
   EXPECT_EQ(c.dqn_refit.learning_rate, c.dqn.learning_rate);  // the rest is dqn:'s
   EXPECT_EQ(c.dqn_refit.hidden_sizes, c.dqn.hidden_sizes);
   EXPECT_NE(c.text.find("dqn_refit"), std::string::npos);
+  // The model that learns, and the returns it learns (trainer.config_target: return), take the refit's gamma.
+  const CooptConfig myopic = load_coopt_config(kCi, {"trainer.config_refit_episodes=2", "dqn_refit.gamma=0"});
+  EXPECT_EQ(config_model_params(myopic, true).gamma, 0.0);
+  EXPECT_EQ(config_model_params(myopic, false).gamma, myopic.dqn.gamma);
+  EXPECT_GT(myopic.dqn.gamma, 0.0);
   // Where nothing is refitted it is no part of the run's identity: a preset's
   // fixed columns are the same runs with and without it.
   for (const char* no_refit : {"trainer.config_refit_episodes=0", "trainer.mode=fixed"})
