@@ -27,7 +27,8 @@ EpisodePlan plan_episode(const TrainerParams& t, int episode) {
   p.config_learns = p.refit || t.config_learns_from == ConfigLearnsFrom::all ||
                     (t.config_learns_from == ConfigLearnsFrom::model && !p.scripted) ||
                     (t.config_learns_from == ConfigLearnsFrom::greedy && p.greedy_motion);
-  p.random_config = p.warmup || (p.scripted && t.pilot_random_configs);
+  p.random_config = p.warmup || (p.scripted && t.pilot_random_configs) ||
+                    (!p.refit && !p.scripted && t.random_config_interval > 0 && episode % t.random_config_interval == 0);
   p.pilot = p.scripted || (t.pilot_labels && !p.refit);
   p.spec.seed = static_cast<std::uint64_t>(t.seed) * 1000003ULL + static_cast<std::uint64_t>(episode);
   p.spec.stair_height = t.stair_height;

@@ -55,7 +55,7 @@ struct EpisodePlan {
   bool scripted = false;       // the scripted pilot drives (warm-up, scripted_interval)
   bool greedy_motion = false;  // the motion model acts without exploration noise
   bool config_learns = false;  // the DQN learns from this episode's decisions
-  bool random_config = false;  // configurations drawn uniformly (warm-up, pilot_random_configs)
+  bool random_config = false;  // configurations drawn uniformly (warm-up, pilot_random_configs, random_config_interval)
   bool pilot = false;          // the pilot plans: BC targets, and drives when scripted
   task::EpisodeSpec spec;      // the scene (seed from trainer.seed and the index)
 };

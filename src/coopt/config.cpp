@@ -98,6 +98,9 @@ void add_fields(YamlFields& f, TrainerParams& p) {
         "after the warm-up, every this-many-th episode is the pilot's too; 0 = none");
   f.add("pilot_random_configs", &p.pilot_random_configs,
         "those pilot episodes draw their chains uniformly instead of asking the DQN");
+  f.add("random_config_interval", &p.random_config_interval, 0, kMaxEpisodes,
+        "after the warm-up, every this-many-th model-driven episode draws its chains uniformly instead of asking "
+        "the DQN (no pilot needed); 0 = none");
   f.add("pilot_gait_per_modules", &p.pilot_gait_per_modules,
         "the pilot climbs with each chain length's searched gait (else one gait for all)");
   f.add("pilot_flat_steering", &p.pilot_flat_steering,

@@ -105,6 +105,10 @@ struct TrainerParams {
   // warm-up does, instead of asking the DQN: the motion model keeps seeing
   // demonstrations with every chain length, and the DQN the outcome of each.
   bool pilot_random_configs = false;
+  // Every this-many-th model-driven training episode draws its configurations
+  // uniformly too (0 = none): the motion model keeps practising every chain
+  // length without a pilot, instead of only the one the DQN settles on.
+  int random_config_interval = 0;
   // The pilot climbs with each chain length's own searched gait
   // (task::searched_stair_gaits); false: one gait (a0, a2, a3, a4) = (1, 1, -0.5, 1) for all.
   bool pilot_gait_per_modules = false;

@@ -9,6 +9,7 @@
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
+#include "coopt/acting.hpp"
 #include "coopt/config.hpp"
 #include "coopt/config_reference.hpp"
 #include "coopt/segment.hpp"
@@ -43,6 +44,24 @@ TEST(CandidateMask, ActionIndexIsTheChainLengthMinusTwo) {
     EXPECT_EQ(module_count(candidates()[a]), modules_of(a)) << a;
     EXPECT_EQ(candidate_index(candidates()[a]), a);
   }
+}
+
+TEST(EpisodePlan, RandomConfigIntervalDrawsEveryKthTrainingEpisodesChainsButNeverTheRefits) {
+  TrainerParams t;
+  t.warmup_episodes = 4;
+  t.episodes = 12;
+  t.config_refit_episodes = 6;
+  auto random_episodes = [&t] {
+    std::vector<int> v;
+    for (int e = 0; e < t.total_episodes(); ++e)
+      if (plan_episode(t, e).random_config) v.push_back(e);
+    return v;
+  };
+  EXPECT_EQ(random_episodes(), (std::vector<int>{0, 1, 2, 3}));  // the warm-up only
+  t.random_config_interval = 5;
+  EXPECT_EQ(random_episodes(), (std::vector<int>{0, 1, 2, 3, 5, 10, 15}));  // 16..21 are the refit's
+  EXPECT_FALSE(plan_episode(t, 5).scripted);
+  EXPECT_FALSE(plan_episode(t, 5).pilot);
 }
 
 TEST(Segment, DecisionReturnsSumTheLaterSegmentsDiscountedOncePerDecision) {
