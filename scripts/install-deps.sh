@@ -7,6 +7,7 @@ packages=(
   build-essential cmake ccache pkg-config
   libmujoco-dev libmujoco-samples libqhull-dev      # physics (+ viewer, testxml)
   libtorch-dev libopenblas0-pthread                 # neural networks on OpenBLAS
+  libblas-dev                                       # cblas.h: the TD3 update's own matrix products (rl/mlp_pass)
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
   nlohmann-json3-dev                                # JSON of evaluation summaries (report)
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -6,6 +6,17 @@
 #include <utility>
 
 namespace comorph::rl {
+namespace {
+
+// Whether `t` can be stepped by the plain loops below: CPU float32,
+// contiguous. A small network's update pays LibTorch's dispatch for each of
+// the ~8 operations of an Adam step, more than the arithmetic; on other
+// devices the operations run as tensors.
+bool plain_loop(const torch::Tensor& t) {
+  return t.device().is_cpu() && t.scalar_type() == torch::kFloat32 && t.is_contiguous();
+}
+
+}  // namespace
 
 FlatParameters::FlatParameters(std::vector<torch::Tensor> parameters, bool with_grad)
     : parameters_(std::move(parameters)), with_grad_(with_grad) {
@@ -33,6 +44,14 @@ void FlatParameters::rebind() {
 
 void soft_update(FlatParameters& target, const FlatParameters& online, double tau) {
   if (target.numel() != online.numel()) throw std::logic_error("soft_update: buffers differ in size");
+  if (plain_loop(target.data()) && plain_loop(online.data())) {
+    float* t = target.data().data_ptr<float>();
+    const float* o = online.data().data_ptr<float>();
+    const auto keep = static_cast<float>(1.0 - tau), take = static_cast<float>(tau);
+    const std::int64_t n = target.numel();  // a constant bound, so that the loop vectorizes
+    for (std::int64_t i = 0; i < n; ++i) t[i] = keep * t[i] + take * o[i];
+    return;
+  }
   torch::NoGradGuard no_grad;
   target.data().mul_(1.0 - tau).add_(online.data(), tau);
 }
@@ -45,8 +64,19 @@ FlatAdam::FlatAdam(std::vector<torch::Tensor> parameters, Options options)
 }
 
 void FlatAdam::clip_grad_norm(double max_norm) {
-  torch::NoGradGuard no_grad;
   const torch::Tensor& g = parameters_.grad();
+  if (plain_loop(g)) {
+    float* d = g.data_ptr<float>();
+    const std::int64_t n = g.numel();
+    double squares = 0;
+    for (std::int64_t i = 0; i < n; ++i) squares += static_cast<double>(d[i]) * d[i];
+    const double scale = max_norm / (std::sqrt(squares) + 1e-6);
+    if (scale >= 1.0) return;
+    const auto f = static_cast<float>(scale);
+    for (std::int64_t i = 0; i < n; ++i) d[i] *= f;
+    return;
+  }
+  torch::NoGradGuard no_grad;
   g.mul_((max_norm / (g.norm() + 1e-6)).clamp_max(1.0));
 }
 
@@ -56,6 +86,23 @@ void FlatAdam::step() {
   const double bias_correction1 = 1 - std::pow(options_.beta1, static_cast<double>(steps_));
   const double bias_correction2 = 1 - std::pow(options_.beta2, static_cast<double>(steps_));
   const torch::Tensor& g = parameters_.grad();
+  if (plain_loop(g) && plain_loop(parameters_.data())) {
+    const float* grad = g.data_ptr<float>();
+    float* p = parameters_.data().data_ptr<float>();
+    float* m = exp_avg_.data_ptr<float>();
+    float* v = exp_avg_sq_.data_ptr<float>();
+    const auto b1 = static_cast<float>(options_.beta1), b2 = static_cast<float>(options_.beta2);
+    const auto step_size = static_cast<float>(options_.learning_rate / bias_correction1);
+    const auto inverse_sqrt_bc2 = static_cast<float>(1.0 / std::sqrt(bias_correction2));
+    const auto epsilon = static_cast<float>(options_.epsilon);
+    const std::int64_t n = g.numel();
+    for (std::int64_t i = 0; i < n; ++i) {
+      m[i] = b1 * m[i] + (1.0f - b1) * grad[i];
+      v[i] = b2 * v[i] + (1.0f - b2) * grad[i] * grad[i];
+      p[i] -= step_size * m[i] / (std::sqrt(v[i]) * inverse_sqrt_bc2 + epsilon);
+    }
+    return;
+  }
   exp_avg_.mul_(options_.beta1).add_(g, 1 - options_.beta1);
   exp_avg_sq_.mul_(options_.beta2).addcmul_(g, g, 1 - options_.beta2);
   torch::sqrt_out(denominator_, exp_avg_sq_);

@@ -3,7 +3,9 @@
 // runs about 8 operations for each parameter tensor, a Polyak update 2, a
 // gradient-norm clip 2 or 3, and a TD3 critic has 12 or more tensors. Over one
 // flat buffer each of these is a single operation, whatever the number of
-// tensors; the arithmetic is the same, element by element.
+// tensors; the arithmetic is the same, element by element. On the CPU
+// (float32) each is a plain loop over the buffer, without LibTorch's
+// dispatch; elsewhere a tensor operation.
 //
 // How: each parameter's data becomes a view into the flat buffer (set_data),
 // and so does its gradient. Autograd adds a backward pass's gradient into a

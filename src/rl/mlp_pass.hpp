@@ -1,21 +1,29 @@
-// The forward and backward passes of an Mlp (rl/networks.hpp) written out as
-// the ATen operations autograd runs for them, into buffers allocated once for
-// a batch size: no autograd graph, no saved-tensor bookkeeping, no tensor
-// allocated per pass.
+// The forward and backward passes of an Mlp (rl/networks.hpp) on the CPU, as
+// BLAS matrix products (cblas_sgemm) and plain loops over float buffers
+// allocated once for a batch size: no autograd graph, no tensor per
+// operation, no LibTorch dispatch.
 //
-// Why: a 64-wide TD3 update is about 100 small operations, and for each one
-// autograd builds a graph node, saves its inputs and allocates its output;
-// at these sizes that costs more than the arithmetic (docs/rl.md, "Speed").
-// The numbers are autograd's bit for bit: the same kernels (addmm for
-// Linear, mm for its gradients, sum over the batch for the bias, ReLU's
-// threshold_backward) on tensors of the same layouts. A test compares whole
-// TD3 trainings both ways.
+// Why: a 64-wide TD3 update is about 100 small operations. Through LibTorch
+// each one costs 1 to 2 us of dispatch and bookkeeping, more than its
+// arithmetic at these sizes (docs/rl.md, "Speed"). Here a layer is one sgemm
+// and one loop.
+//
+// The numbers are autograd's up to float rounding: the same products, with
+// sums taken in other orders (a bias gradient's batch sum, a tanh). A test
+// compares whole TD3 trainings both ways.
+//
+// Activations are stored feature-major: a batch of rows is [features,
+// batch], row-major (the transpose of a batch tensor). A layer's product is
+// then W x with both untransposed, which OpenBLAS runs on its small-matrix
+// kernels; the batch-major x W^T takes its packing path at these sizes, as
+// does only the hidden layers' weight gradient here.
 //
 // One pass object serves any Mlp of the shape it was built for (online or
 // target network): forward() names the network, backward() follows the last
 // forward(). Gradients are written into the parameters' .grad() tensors
 // (with FlatAdam, views of its flat gradient buffer), replacing what was
 // there, as zero_grad() followed by autograd's accumulation would leave them.
+// CPU float32 parameters only (supports()); other devices train on autograd.
 #pragma once
 
 #include <torch/torch.h>
@@ -31,24 +39,33 @@ class MlpPass {
  public:
   MlpPass() = default;
   // Buffers for `batch` rows through networks shaped as `shape` (any Mlp of
-  // the same layer sizes), on the device of its parameters.
+  // the same layer sizes). Throws unless supports(shape).
   MlpPass(const Mlp& shape, std::int64_t batch);
 
-  // The output [batch, out] of `net` for `input` [batch, in] (contiguous).
-  // `input` must stay unchanged until backward().
-  const torch::Tensor& forward(const Mlp& net, const torch::Tensor& input);
+  // Whether the passes can run `net`: contiguous float32 parameters on the CPU.
+  static bool supports(const Mlp& net);
 
-  // From d loss / d output [batch, out]: with parameter_grads, the gradients
+  // The output [out, batch] of `net` for `input` [in, batch] (feature-major).
+  // `input` must stay unchanged until backward(); the output may be changed
+  // in place (backward() does not read it).
+  float* forward(const Mlp& net, const float* input);
+
+  // From d loss / d output [out, batch]: with parameter_grads, the gradients
   // of the last forward()'s network written into its parameters' .grad();
-  // with input_grad, d loss / d input into input_grad().
-  void backward(const torch::Tensor& output_grad, bool parameter_grads, bool input_grad);
-  const torch::Tensor& input_grad() const { return grads_.front(); }
+  // with input_grad, d loss / d input into input_grad() [in, batch].
+  void backward(const float* output_grad, bool parameter_grads, bool input_grad);
+  const float* input_grad() const { return grads_.front().data(); }
 
  private:
+  struct LayerShape {
+    int in, out;
+  };
   Mlp net_{nullptr};
-  torch::Tensor input_;
-  std::vector<torch::Tensor> outputs_;  // of each layer, after its ReLU (none on the last)
-  std::vector<torch::Tensor> grads_;    // d loss / d (input of layer i)
+  int batch_ = 0;
+  std::vector<LayerShape> shapes_;
+  const float* input_ = nullptr;
+  std::vector<std::vector<float>> outputs_;  // of each layer, after its ReLU (none on the last)
+  std::vector<std::vector<float>> grads_;    // d loss / d (input of layer i)
 };
 
 }  // namespace comorph::rl

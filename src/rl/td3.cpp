@@ -99,7 +99,7 @@ void Td3::update() {
   const torch::Tensor smoothing =
       gaussian_noise(config_.batch_size, action_dims_, config_.policy_noise, rng_, device_)
           .clamp(-config_.noise_clip, config_.noise_clip);
-  if (spec_.has_image() || force_autograd_)
+  if (spec_.has_image() || force_autograd_ || !MlpPass::supports(nets_->actor))
     update_with_autograd(batch_, smoothing);
   else
     update_with_explicit_passes(batch_, smoothing);
@@ -138,69 +138,97 @@ void Td3::update_with_autograd(const ReplayBatch& b, const torch::Tensor& smooth
   }
 }
 
-// The update above, pass by pass: each gradient is the one autograd computes
-// for the same loss, with the same operations (rl/mlp_pass.hpp). The
+// The update above, pass by pass on the CPU (rl/mlp_pass.hpp): each gradient
+// is the one autograd computes for the same loss, up to float rounding. The
 // observation is the vector alone, so the critics' features are b.vector.
+// Activations are feature-major ([features, batch]): element (j, r) of a
+// [B, n] batch tensor is at r * n + j, of a pass's buffer at j * B + r.
 void Td3::update_with_explicit_passes(const ReplayBatch& b, const torch::Tensor& smoothing) {
-  c10::InferenceMode no_autograd;  // nothing here is differentiated: skip autograd's dispatch too
-  const std::int64_t batch = config_.batch_size, obs = spec_.vector_size, act = action_dims_;
+  const int batch = static_cast<int>(config_.batch_size), obs = spec_.vector_size, act = action_dims_;
   if (!explicit_) {
-    const auto options = b.reward.options();
-    explicit_ = std::make_unique<ExplicitUpdate>(ExplicitUpdate{
-        MlpPass(nets_->actor, batch), MlpPass(nets_->critic1, batch), torch::empty({batch, obs + act}, options),
-        torch::empty({batch}, options), torch::empty({batch}, options), torch::empty({batch, act}, options),
-        torch::empty({batch, act}, options), torch::empty({batch, act}, options), torch::ones({}, options)});
+    const auto size = [&](int n) { return std::vector<float>(static_cast<std::size_t>(batch) * n); };
+    explicit_ = std::make_unique<ExplicitUpdate>(
+        ExplicitUpdate{MlpPass(nets_->actor, batch), MlpPass(nets_->critic1, batch), size(obs), size(obs),
+                       size(obs + act), size(1), size(1), size(act)});
   }
   ExplicitUpdate& e = *explicit_;
-  // The critics' input cat({observation, action}, 1), in the one buffer.
-  const auto set_critic_input = [&](const torch::Tensor& observation, const torch::Tensor& action) {
-    e.critic_input.narrow(1, 0, obs).copy_(observation);
-    e.critic_input.narrow(1, obs, act).copy_(action);
+  // [B, n] batch-major into [n, B] feature-major.
+  const auto transpose_into = [batch](const float* from, int n, float* to) {
+    for (int r = 0; r < batch; ++r)
+      for (int j = 0; j < n; ++j) to[static_cast<std::ptrdiff_t>(j) * batch + r] = from[static_cast<std::ptrdiff_t>(r) * n + j];
   };
-  const auto q_of = [&](Mlp& critic) { return e.critic.forward(critic, e.critic_input).view({batch}); };
+  transpose_into(b.vector.data_ptr<float>(), obs, e.observation.data());
+  transpose_into(b.next_vector.data_ptr<float>(), obs, e.next_observation.data());
+  const float* reward = b.reward.data_ptr<float>();
+  const float* bootstrap = b.bootstrap.data_ptr<float>();
+  const float* noise = smoothing.data_ptr<float>();  // [B, A]
+  // The critics' input cat({observation, action}, 1): its first obs rows, then the action's.
+  float* const critic_action = e.critic_input.data() + static_cast<std::ptrdiff_t>(obs) * batch;
+  const auto set_critic_observation = [&](const std::vector<float>& observation) {
+    std::copy(observation.begin(), observation.end(), e.critic_input.begin());
+  };
+  const auto q_of = [&](Mlp& critic) { return e.critic.forward(critic, e.critic_input.data()); };
 
   // Critic target: r + gamma^k (1 - terminated) min(Q1', Q2')(s', pi'(s') + clipped noise).
-  const torch::Tensor& next_a = e.actor.forward(target_->actor, b.next_vector);
-  next_a.tanh_().add_(smoothing).clamp_(-1.0, 1.0);
-  set_critic_input(b.next_vector, next_a);
-  e.y.copy_(q_of(target_->critic1));
-  at::minimum_out(e.y, e.y, q_of(target_->critic2));
-  e.y.mul_(b.bootstrap).add_(b.reward);
+  const float* next_a = e.actor.forward(target_->actor, e.next_observation.data());
+  for (int j = 0; j < act; ++j)
+    for (int r = 0; r < batch; ++r) {
+      const int i = j * batch + r;
+      critic_action[i] = std::clamp(std::tanh(next_a[i]) + noise[r * act + j], -1.0f, 1.0f);
+    }
+  set_critic_observation(e.next_observation);
+  std::copy_n(q_of(target_->critic1), batch, e.y.data());
+  const float* q2 = q_of(target_->critic2);
+  for (int r = 0; r < batch; ++r) e.y[r] = reward[r] + bootstrap[r] * std::min(e.y[r], q2[r]);
 
   // Twin critics: MSE to y each; their parameters are disjoint, so one after the other.
-  set_critic_input(b.vector, b.action);
-  torch::Tensor loss;
+  set_critic_observation(e.observation);
+  transpose_into(b.action.data_ptr<float>(), act, critic_action);
+  double loss = 0;
   for (Mlp* critic : {&nets_->critic1, &nets_->critic2}) {
-    const torch::Tensor q = q_of(*critic);
-    loss = loss.defined() ? loss + torch::mse_loss(q, e.y) : torch::mse_loss(q, e.y);
-    at::mse_loss_backward_out(e.q_grad, e.one, q, e.y, at::Reduction::Mean);
-    e.critic.backward(e.q_grad.view({batch, 1}), /*parameter_grads=*/true, /*input_grad=*/false);
+    const float* q = q_of(*critic);
+    double squares = 0;
+    for (int r = 0; r < batch; ++r) {
+      const float diff = q[r] - e.y[r];
+      squares += static_cast<double>(diff) * diff;
+      e.q_grad[r] = 2.0f * diff / static_cast<float>(batch);
+    }
+    loss += squares / batch;
+    e.critic.backward(e.q_grad.data(), /*parameter_grads=*/true, /*input_grad=*/false);
   }
   clip_and_step(*critic_optimizer_, config_.max_grad_norm);
-  last_loss_ = loss.item<double>();
+  last_loss_ = loss;
   ++counters_.updates;
   if (counters_.updates % config_.policy_delay != 0) return;
 
   // Delayed actor update: maximise Q1(s, pi(s)) (+ behaviour cloning).
-  const torch::Tensor& pi = e.actor.forward(nets_->actor, b.vector);
-  pi.tanh_();
-  set_critic_input(b.vector, pi);
-  const torch::Tensor q = q_of(nets_->critic1);
-  // d loss / d q of -mean(q) [/ mean|q|], in autograd's order: divide, negate, spread over the batch.
-  const double w = config_.bc_weight > 0 ? bc_weight_now() : 0.0;
-  torch::Tensor d_mean = config_.bc_weight > 0 ? (e.one / q.abs().mean().clamp_min(1e-6)).neg() : -e.one;
-  if (config_.actor_q_weight != 1) d_mean = d_mean * config_.actor_q_weight;
-  e.q_grad.copy_(d_mean.expand({batch})).div_(batch);
-  e.critic.backward(e.q_grad.view({batch, 1}), /*parameter_grads=*/false, /*input_grad=*/true);
-  torch::Tensor d_pi = e.critic.input_grad().narrow(1, obs, act);
-  if (w > 0) {
-    // w * mean(sum_j (pi - target)^2 * has_target): (w / B * has_target) * 2 (pi - target).
-    e.bc_grad.copy_(pi).sub_(b.target).mul_(2.0);
-    e.bc_grad.mul_((e.one * w).expand({batch}).div(batch).mul(b.has_target).unsqueeze(1));
-    d_pi = at::add_out(e.pi_grad, d_pi, e.bc_grad);
+  float* pi = e.actor.forward(nets_->actor, e.observation.data());
+  for (int i = 0; i < batch * act; ++i) critic_action[i] = pi[i] = std::tanh(pi[i]);
+  const float* q = q_of(nets_->critic1);
+  // d loss / d q of -mean(q) [/ mean|q|]: the same value for every row.
+  double d_mean = -config_.actor_q_weight / batch;
+  if (config_.bc_weight > 0) {
+    double abs_sum = 0;
+    for (int r = 0; r < batch; ++r) abs_sum += std::abs(q[r]);
+    d_mean /= std::max(abs_sum / batch, 1e-6);
   }
-  at::tanh_backward_out(e.actor_output_grad, d_pi, pi);
-  e.actor.backward(e.actor_output_grad, /*parameter_grads=*/true, /*input_grad=*/false);
+  std::fill(e.q_grad.begin(), e.q_grad.end(), static_cast<float>(d_mean));
+  e.critic.backward(e.q_grad.data(), /*parameter_grads=*/false, /*input_grad=*/true);
+  // d loss / d pi, from the critic's input gradient, plus behaviour cloning's
+  // w * mean(sum_j (pi - target)^2 * has_target), then through the tanh.
+  const double w = config_.bc_weight > 0 ? bc_weight_now() : 0.0;
+  const auto bc_scale = static_cast<float>(2.0 * w / batch);
+  const float* target = b.target.data_ptr<float>();
+  const float* has_target = b.has_target.data_ptr<float>();
+  const float* d_critic_action = e.critic.input_grad() + static_cast<std::ptrdiff_t>(obs) * batch;
+  for (int j = 0; j < act; ++j)
+    for (int r = 0; r < batch; ++r) {
+      const int i = j * batch + r;
+      float d_pi = d_critic_action[i];
+      if (w > 0) d_pi += bc_scale * has_target[r] * (pi[i] - target[r * act + j]);
+      e.actor_output_grad[i] = d_pi * (1.0f - pi[i] * pi[i]);
+    }
+  e.actor.backward(e.actor_output_grad.data(), /*parameter_grads=*/true, /*input_grad=*/false);
   clip_and_step(*actor_optimizer_, config_.max_grad_norm);
   actor_step_done();
 }

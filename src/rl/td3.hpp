@@ -11,6 +11,7 @@
 #include <torch/torch.h>
 
 #include <memory>
+#include <vector>
 
 #include "rl/mlp_pass.hpp"
 #include "rl/networks.hpp"
@@ -34,8 +35,9 @@ class Td3 final : public OffPolicyLearner {
   double bc_weight_now() const;  // w of the behaviour-cloning term at the current update
   const Td3Config& config() const { return config_; }
   ActorCritic& networks() { return nets_; }
-  // A vector observation's update runs on explicit passes (rl/mlp_pass.hpp),
-  // an image's on autograd (the convolutions). Both give the same numbers;
+  // A vector observation's update on the CPU runs on explicit passes
+  // (rl/mlp_pass.hpp); an image's (the convolutions), or any on another
+  // device, on autograd. Both give the same numbers up to float rounding;
   // forcing autograd is for comparing them (a test) and timing them (bench_rl).
   void force_autograd(bool on) { force_autograd_ = on; }
 
@@ -51,13 +53,13 @@ class Td3 final : public OffPolicyLearner {
   // The target networks' actor and critic parameters, laid out as the optimizers' (one Polyak step each).
   mutable FlatParameters target_actor_, target_critic_;
 
-  // Buffers of the explicit update, built at its first use.
+  // Buffers of the explicit update, built at its first use; feature-major ([n, B]).
   struct ExplicitUpdate {
-    MlpPass actor, critic;       // any actor / critic network (online or target)
-    torch::Tensor critic_input;  // [B, observation + action]: the critics' cat
-    torch::Tensor y, q_grad;     // [B]
-    torch::Tensor bc_grad, pi_grad, actor_output_grad;  // [B, A]
-    torch::Tensor one;           // 0-dim 1: d loss / d loss
+    MlpPass actor, critic;                          // any actor / critic network (online or target)
+    std::vector<float> observation, next_observation;  // [observation, B]
+    std::vector<float> critic_input;                // [observation + action, B]: the critics' cat
+    std::vector<float> y, q_grad;                   // [B]
+    std::vector<float> actor_output_grad;           // [A, B]
   };
   std::unique_ptr<ExplicitUpdate> explicit_;
   ReplayBatch batch_;  // reused by each update (ReplayBuffer::sample_into)

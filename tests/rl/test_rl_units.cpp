@@ -6,7 +6,9 @@
 #include <cmath>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <iostream>
 #include <random>
 
 #include "rl/classic/cartpole.hpp"
@@ -691,24 +693,36 @@ TEST(Td3, ActorQWeightZeroLeavesTheActorToImitationAlone) {
   }
 }
 
-// TD3's explicit passes (rl/mlp_pass.hpp) compute what autograd computes,
-// bit for bit: two learners of one seed, one forced onto autograd, train on the
-// same transitions and end with equal networks, targets, optimizer states and
-// losses. With and without behaviour cloning (decaying, so that its weight
-// reaches 0), clipping, a batch that is not a power of two, two layers and one.
-// Every tensor of `a` equals the one under the same key of `b`, in nested archives too.
-void expect_equal_archives(torch::serialize::InputArchive& a, torch::serialize::InputArchive& b,
-                           const std::string& prefix, int& compared) {
+// TD3's explicit passes (rl/mlp_pass.hpp) compute what autograd computes, up
+// to float rounding: two learners of one seed, one forced onto autograd, train
+// on the same transitions and end with networks, targets and optimizer states
+// that agree to a few parts in 10^5, and losses to 10^-4 relative, update by
+// update. A wrong gradient (a transposed product, a sign, the
+// ReLU or tanh derivative left out) moves the networks apart by orders of
+// magnitude more within the first updates. With and without behaviour cloning
+// (decaying, so that its weight reaches 0), clipping, a batch that is not a
+// power of two, two layers and one.
+// Every tensor of `a` is close to the one under the same key of `b`, in nested
+// archives too; `largest` is the largest absolute difference seen.
+void expect_close_archives(torch::serialize::InputArchive& a, torch::serialize::InputArchive& b,
+                           const std::string& prefix, int& compared, double& largest) {
   for (const std::string& key : a.keys()) {
     torch::Tensor ta, tb;
     torch::serialize::InputArchive sa, sb;
     if (a.try_read(key, ta)) {
       ASSERT_TRUE(b.try_read(key, tb)) << prefix << key;
-      EXPECT_TRUE(torch::equal(ta, tb)) << prefix << key;
+      ASSERT_EQ(ta.sizes(), tb.sizes()) << prefix << key;
+      if (ta.is_floating_point()) {
+        const double difference = (ta - tb).abs().max().item<double>();
+        largest = std::max(largest, difference);
+        EXPECT_TRUE(torch::allclose(ta, tb, /*rtol=*/1e-4, /*atol=*/1e-5)) << prefix << key << ": " << difference;
+      } else {
+        EXPECT_TRUE(torch::equal(ta, tb)) << prefix << key;
+      }
       ++compared;
     } else if (a.try_read(key, sa)) {
       ASSERT_TRUE(b.try_read(key, sb)) << prefix << key;
-      expect_equal_archives(sa, sb, prefix + key + "/", compared);
+      expect_close_archives(sa, sb, prefix + key + "/", compared, largest);
     }
   }
 }
@@ -722,7 +736,7 @@ struct ExplicitPassCase {
 
 class Td3ExplicitPasses : public ::testing::TestWithParam<ExplicitPassCase> {};
 
-TEST_P(Td3ExplicitPasses, EqualAutogradBitForBit) {
+TEST_P(Td3ExplicitPasses, EqualAutogradUpToRounding) {
   rl::Td3Config c;
   c.hidden_sizes = GetParam().hidden;
   c.batch_size = 37;
@@ -750,7 +764,8 @@ TEST_P(Td3ExplicitPasses, EqualAutogradBitForBit) {
   for (int update = 0; update < 200; ++update) {
     explicit_passes.update();
     autograd.update();
-    ASSERT_EQ(explicit_passes.last_loss(), autograd.last_loss()) << "update " << update;
+    ASSERT_NEAR(explicit_passes.last_loss(), autograd.last_loss(), 1e-4 * std::abs(autograd.last_loss()) + 1e-7)
+        << "update " << update;
   }
   const std::string path_e = temp_path("td3_explicit.pt"), path_a = temp_path("td3_autograd.pt");
   explicit_passes.save_without_replay(path_e);
@@ -759,8 +774,10 @@ TEST_P(Td3ExplicitPasses, EqualAutogradBitForBit) {
   ae.load_from(path_e);
   aa.load_from(path_a);
   int compared = 0;
-  expect_equal_archives(ae, aa, "", compared);
+  double largest = 0;
+  expect_close_archives(ae, aa, "", compared, largest);
   EXPECT_GT(compared, 20);
+  std::cout << "largest difference after 200 updates: " << largest << "\n";
   std::filesystem::remove(path_e);
   std::filesystem::remove(path_a);
 }
