@@ -150,9 +150,9 @@ std::array<Clock::duration, kPhases> ActorRanks::actor_time() const {
   return spent;
 }
 
-void serve_actor_rank(const CooptConfig& config) {
+void serve_actor_rank(const CooptConfig& config, const std::function<int(int, int)>& label_source) {
   rl::set_torch_threads(config.trainer.torch_threads, 1);  // as the host's process sets its own (TrainingState)
-  Actor actor(config, mpi_actor_ranks(), {});
+  Actor actor(config, mpi_actor_ranks(), label_source);
   RankLink link;
   actor.serve(link);
 }

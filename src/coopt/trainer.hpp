@@ -89,7 +89,8 @@ struct TrainerCallbacks {
   std::function<void(const DecisionLog&)> on_decision;      // after every stored DQN transition
   // Optional custom labeller for scene_source: ground_truth (tests, other
   // label sources): (control step of the episode, ground-truth label) -> label
-  // fed to the switch detector.
+  // fed to the switch detector. With MPI actors, give the same to
+  // serve_actor_rank on every actor rank.
   std::function<int(int, int)> label_source;
 };
 
@@ -174,8 +175,11 @@ class MpiJob {
 enum class ActorPlacement { threads, mpi_ranks };
 
 // An actor rank of an MPI job: plays what rank 0's trainer orders until that
-// trainer ends the run. `config` must be the run's.
-void serve_actor_rank(const CooptConfig& config);
+// trainer ends the run. `config` must be the run's. `label_source` is
+// TrainerCallbacks::label_source: code, not data, so it cannot travel with the
+// orders; a program that gives rank 0's trainer one passes the same here on
+// every actor rank (the `comorph train` command uses none).
+void serve_actor_rank(const CooptConfig& config, const std::function<int(int, int)>& label_source = {});
 
 class Trainer {
  public:
