@@ -89,6 +89,9 @@ void add_fields(YamlFields& f, TrainerParams& p) {
   f.add("config_vector", &p.config_vector, "the DQN sees [C_n / 10, scene one-hot] beside its image");
   f.add("motion_clearance", &p.motion_clearance,
         "the motion model sees the clearance row (nearest depth per column, or the obstacle scan)");
+  f.add("motion_heads_per_chain", &p.motion_heads_per_chain,
+        "the motion actor has one output head per chain length (2..10), chosen by a one-hot of the length appended "
+        "to its vector (TD3 only)");
   f.add("normalize_state", &p.normalize_state, "scale the state's fields to about [-1, 1]");
   f.add("decision_camera", &p.decision_camera, "the DQN sees the decision camera (env.robot.decision_*)");
   f.add("warmup_policy", &p.warmup_policy,
@@ -158,6 +161,9 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
     fail(source, pre + ".motion_algo", "'" + quote_value(p.motion_algo) + "' is not one of " + names +
                                            " (the registered learners of continuous actions)");
   }
+  if (p.motion_heads_per_chain && p.motion_algo != "td3")
+    fail(source, pre + ".motion_heads_per_chain", "actor heads per chain length need trainer.motion_algo td3, not '" +
+                                                      quote_value(p.motion_algo) + "'");
   if (p.config_learns_from == ConfigLearnsFrom::greedy && p.greedy_motion_interval < 1)
     fail(source, pre + ".config_learns_from", "greedy needs trainer.greedy_motion_interval >= 1");
   if (!p.refit_motion_from.empty()) {

@@ -91,6 +91,11 @@ struct TrainerParams {
   int simulation_threads = 1;
   bool motion_image = true;           // the motion model sees the depth image (CNN) + state; false: state only
   bool motion_clearance = false;      // the motion model also sees task's clearance(): nearest depth per image column
+  // The motion model's actor has one output head per chain length (2..10
+  // modules; the hidden layers shared), chosen by a one-hot of the chain's
+  // length appended to its vector: each chain's gait learns apart from the
+  // others'. TD3 only. The paper's "separate groups of motion parameters".
+  bool motion_heads_per_chain = false;
   bool normalize_state = false;       // scale the state vector's fields to about [-1, 1] (fixed factors, trainer.cpp)
   bool config_vector = true;          // the DQN sees [C_n / 10, scene one-hot x3] beside the depth image
   bool decision_camera = false;       // the DQN sees the decision camera (env.robot.decision_*), not the motion camera

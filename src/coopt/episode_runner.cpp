@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <stdexcept>
+#include <string>
 
 #include "coopt/segment.hpp"
 #include "perception/scene_classifier.hpp"
@@ -50,6 +52,10 @@ rl::ObservationSpec motion_spec(const CooptConfig& c) {
   }
   s.vector_size =
       task::obs::kStateSize + (c.trainer.motion_clearance ? task::MultiTaskEnv::clearance_width(c.env.robot) : 0);
+  if (c.trainer.motion_heads_per_chain) {
+    s.head_selector = kMaxModules - kMinModules + 1;
+    s.vector_size += s.head_selector;
+  }
   return s;
 }
 
@@ -122,8 +128,18 @@ void fill_motion(const float* depth, const float* state, const float* clearance,
     }
     o.vector[static_cast<std::size_t>(i)] = v;
   }
-  if (t.motion_clearance)
-    std::copy(clearance, clearance + (o.vector.size() - task::obs::kStateSize), o.vector.begin() + task::obs::kStateSize);
+  const int selector = t.motion_heads_per_chain ? kMaxModules - kMinModules + 1 : 0;
+  const auto rest = o.vector.begin() + task::obs::kStateSize;  // the clearance row, then the head selector
+  if (t.motion_clearance) std::copy(clearance, clearance + (o.vector.end() - rest - selector), rest);
+  if (selector > 0) {
+    // A one-hot of the chain's length, counted from the state's module mask.
+    const int modules = static_cast<int>(
+        std::count_if(state + task::obs::kModuleMask, state + task::obs::kModuleMask + kMaxModules,
+                      [](float present) { return present > 0.5f; }));
+    if (modules < kMinModules) throw std::logic_error("fill_motion: a state with " + std::to_string(modules) + " modules");
+    std::fill(o.vector.end() - selector, o.vector.end(), 0.0f);
+    o.vector[o.vector.size() - static_cast<std::size_t>(selector) + static_cast<std::size_t>(modules - kMinModules)] = 1.0f;
+  }
 }
 
 void fill_config_vector(const TrainerParams& t, const Configuration& current, int scene,

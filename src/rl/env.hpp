@@ -23,10 +23,25 @@ struct ObservationSpec {
   int image_height = 0;    // pixels
   int image_width = 0;     // pixels
   int vector_size = 0;     // 0 = no vector
+  // 0, or the vector's last head_selector values are a one-hot choice of one
+  // of that many actor heads: TD3's actor then has one group of outputs per
+  // head, and a row acts and learns through its chosen group only (the
+  // hidden layers are shared). The selector is part of the vector, so both
+  // networks see it as input too.
+  int head_selector = 0;
 
   bool has_image() const { return image_channels > 0; }
   bool has_vector() const { return vector_size > 0; }
   int image_size() const { return image_channels * image_height * image_width; }
+  int actor_heads() const { return head_selector > 0 ? head_selector : 1; }
+  // The head a vector chooses: the position of the largest value of its
+  // selector block (0 without one).
+  int head_of(const float* vector) const {
+    int head = 0;
+    for (int k = 1; k < head_selector; ++k)
+      if (vector[vector_size - head_selector + k] > vector[vector_size - head_selector + head]) head = k;
+    return head;
+  }
 };
 
 enum class ActionKind { kDiscrete, kContinuous };

@@ -6,17 +6,9 @@
 #include <utility>
 
 namespace comorph::rl {
-namespace {
-
-// Whether `t` can be stepped by the plain loops below: CPU float32,
-// contiguous. A small network's update pays LibTorch's dispatch for each of
-// the ~8 operations of an Adam step, more than the arithmetic; on other
-// devices the operations run as tensors.
-bool plain_loop(const torch::Tensor& t) {
+bool is_plain_cpu_float(const torch::Tensor& t) {
   return t.device().is_cpu() && t.scalar_type() == torch::kFloat32 && t.is_contiguous();
 }
-
-}  // namespace
 
 FlatParameters::FlatParameters(std::vector<torch::Tensor> parameters, bool with_grad)
     : parameters_(std::move(parameters)), with_grad_(with_grad) {
@@ -44,7 +36,7 @@ void FlatParameters::rebind() {
 
 void soft_update(FlatParameters& target, const FlatParameters& online, double tau) {
   if (target.numel() != online.numel()) throw std::logic_error("soft_update: buffers differ in size");
-  if (plain_loop(target.data()) && plain_loop(online.data())) {
+  if (is_plain_cpu_float(target.data()) && is_plain_cpu_float(online.data())) {
     float* t = target.data().data_ptr<float>();
     const float* o = online.data().data_ptr<float>();
     const auto keep = static_cast<float>(1.0 - tau), take = static_cast<float>(tau);
@@ -65,7 +57,7 @@ FlatAdam::FlatAdam(std::vector<torch::Tensor> parameters, Options options)
 
 void FlatAdam::clip_grad_norm(double max_norm) {
   const torch::Tensor& g = parameters_.grad();
-  if (plain_loop(g)) {
+  if (is_plain_cpu_float(g)) {
     float* d = g.data_ptr<float>();
     const std::int64_t n = g.numel();
     double squares = 0;
@@ -86,7 +78,7 @@ void FlatAdam::step() {
   const double bias_correction1 = 1 - std::pow(options_.beta1, static_cast<double>(steps_));
   const double bias_correction2 = 1 - std::pow(options_.beta2, static_cast<double>(steps_));
   const torch::Tensor& g = parameters_.grad();
-  if (plain_loop(g) && plain_loop(parameters_.data())) {
+  if (is_plain_cpu_float(g) && is_plain_cpu_float(parameters_.data())) {
     const float* grad = g.data_ptr<float>();
     float* p = parameters_.data().data_ptr<float>();
     float* m = exp_avg_.data_ptr<float>();

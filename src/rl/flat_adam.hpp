@@ -24,6 +24,12 @@
 
 namespace comorph::rl {
 
+// Whether plain loops over `t`'s floats can stand in for tensor operations:
+// CPU, float32, contiguous. At small sizes LibTorch's dispatch costs more than
+// the arithmetic (an Adam step is ~8 operations); on other devices the
+// operations run as tensors.
+bool is_plain_cpu_float(const torch::Tensor& t);
+
 class FlatParameters {
  public:
   FlatParameters() = default;
@@ -80,7 +86,8 @@ class FlatAdam {
  private:
   FlatParameters parameters_;
   Options options_;
-  torch::Tensor exp_avg_, exp_avg_sq_, denominator_;
+  torch::Tensor exp_avg_, exp_avg_sq_;
+  torch::Tensor denominator_;  // scratch of the tensor path (other devices)
   std::int64_t steps_ = 0;
 };
 

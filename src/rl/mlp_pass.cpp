@@ -5,18 +5,12 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "rl/flat_adam.hpp"
+
 namespace comorph::rl {
-namespace {
-
-bool is_cpu_float(const torch::Tensor& t) {
-  return t.device().is_cpu() && t.scalar_type() == torch::kFloat32 && t.is_contiguous();
-}
-
-}  // namespace
-
 bool MlpPass::supports(const Mlp& net) {
   for (const auto& layer : net->layers())
-    if (!is_cpu_float(layer->weight) || !is_cpu_float(layer->bias)) return false;
+    if (!is_plain_cpu_float(layer->weight) || !is_plain_cpu_float(layer->bias)) return false;
   return true;
 }
 

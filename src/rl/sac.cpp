@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 namespace comorph::rl {
 namespace {
 
 ActorCritic make_networks(const ObservationSpec& spec, int action_dims, const SacConfig& c) {
+  if (spec.head_selector > 0)
+    throw std::invalid_argument("sac: actor heads (an observation with a head selector) are TD3's only");
   // The actor outputs a mean and a log-std per action dimension.
   ActorCritic nets(spec, action_dims, 2 * action_dims, c.hidden_sizes, c.image_features, c.image_fc_size,
                    c.share_encoder);

@@ -3,14 +3,19 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace comorph::rl {
 namespace {
 
 ActorCritic make_networks(const ObservationSpec& spec, int action_dims, const Td3Config& c) {
-  ActorCritic nets(spec, action_dims, action_dims, c.hidden_sizes, c.image_features, c.image_fc_size,
-                   c.share_encoder);
+  if (spec.head_selector < 0 || spec.head_selector > spec.vector_size)
+    throw std::invalid_argument("td3: the observation's head selector (" + std::to_string(spec.head_selector) +
+                                " values) does not fit its vector of " + std::to_string(spec.vector_size));
+  ActorCritic nets(spec, action_dims, action_dims * spec.actor_heads(), c.hidden_sizes, c.image_features,
+                   c.image_fc_size, c.share_encoder);
   nets->to(torch::Device(c.device));
   return nets;
 }
@@ -19,6 +24,17 @@ double noise_std(const Td3Config& c, const LearnerCounters& n) {
   const double t = c.exploration_noise_unit == NoiseDecayUnit::episodes ? static_cast<double>(n.episodes)
                                                                         : static_cast<double>(n.transitions);
   return LinearSchedule{c.exploration_noise_start, c.exploration_noise_end, c.exploration_noise_decay}.at(t);
+}
+
+// The action outputs ([B, A]) of each row's chosen head, of the actor's
+// outputs [B, heads x A]; `vector` [B, V] holds the selector.
+torch::Tensor chosen_heads(const torch::Tensor& outputs, const ObservationSpec& spec, const torch::Tensor& vector,
+                           int action_dims) {
+  if (spec.head_selector == 0) return outputs;
+  const torch::Tensor head = vector.slice(1, spec.vector_size - spec.head_selector).argmax(1);
+  return outputs.view({-1, spec.head_selector, action_dims})
+      .gather(1, head.view({-1, 1, 1}).expand({-1, 1, action_dims}))
+      .squeeze(1);
 }
 
 // One step of the exploration noise's unit process in `z` (one value per
@@ -56,7 +72,10 @@ void act_with(ActorCritic& nets, const ObservationSpec& spec, int action_dims, c
     return;
   }
   const bool from_actor = act_continuous(c, action_dims, n, explore, rng, action, [&] {
-    return torch::tanh(nets->actor_head(actor_features_of(nets, o, spec, device)));
+    const torch::Tensor outputs = nets->actor_head(actor_features_of(nets, o, spec, device));
+    if (spec.head_selector == 0) return torch::tanh(outputs);
+    const int head = spec.head_of(o.vector.data());
+    return torch::tanh(outputs.slice(1, head * action_dims, (head + 1) * action_dims));
   });
   if (!from_actor || !explore) return;
   if (rho <= 0) {
@@ -112,7 +131,8 @@ void Td3::update_with_autograd(const ReplayBatch& b, const torch::Tensor& smooth
     torch::NoGradGuard no_grad;
     const torch::Tensor next_f = target_->critic_features(b.next_image, b.next_vector);
     const torch::Tensor next_actor_f = target_->actor_features(b.next_image, b.next_vector, next_f);
-    const torch::Tensor next_a = (torch::tanh(target_->actor_head(next_actor_f)) + smoothing).clamp(-1.0, 1.0);
+    const torch::Tensor next_pi = chosen_heads(target_->actor_head(next_actor_f), spec_, b.next_vector, action_dims_);
+    const torch::Tensor next_a = (torch::tanh(next_pi) + smoothing).clamp(-1.0, 1.0);
     const torch::Tensor next_q = torch::min(target_->q1(next_f, next_a), target_->q2(next_f, next_a));
     y = b.reward + b.bootstrap * next_q;
   }
@@ -125,7 +145,7 @@ void Td3::update_with_autograd(const ReplayBatch& b, const torch::Tensor& smooth
     // learns from the critic loss only).
     const torch::Tensor critic_f = f.detach();
     const torch::Tensor actor_f = nets_->actor_features(b.image, b.vector, critic_f);
-    const torch::Tensor pi = torch::tanh(nets_->actor_head(actor_f));
+    const torch::Tensor pi = torch::tanh(chosen_heads(nets_->actor_head(actor_f), spec_, b.vector, action_dims_));
     const torch::Tensor q = nets_->q1(critic_f, pi);
     // With behaviour cloning, Q normalised by its batch magnitude, so that w means the same at any reward scale.
     const bool bc = config_.bc_weight > 0;
@@ -143,15 +163,23 @@ void Td3::update_with_autograd(const ReplayBatch& b, const torch::Tensor& smooth
 // observation is the vector alone, so the critics' features are b.vector.
 // Activations are feature-major ([features, batch]): element (j, r) of a
 // [B, n] batch tensor is at r * n + j, of a pass's buffer at j * B + r.
+// With actor heads, row r's action j is the actor's output
+// (head[r] * A + j, r); the other heads' outputs get no gradient from it.
 void Td3::update_with_explicit_passes(const ReplayBatch& b, const torch::Tensor& smoothing) {
   const int batch = static_cast<int>(config_.batch_size), obs = spec_.vector_size, act = action_dims_;
   if (!explicit_) {
     const auto size = [&](int n) { return std::vector<float>(static_cast<std::size_t>(batch) * n); };
-    explicit_ = std::make_unique<ExplicitUpdate>(
-        ExplicitUpdate{MlpPass(nets_->actor, batch), MlpPass(nets_->critic1, batch), size(obs), size(obs),
-                       size(obs + act), size(1), size(1), size(act)});
+    explicit_ = std::make_unique<ExplicitUpdate>(ExplicitUpdate{
+        MlpPass(nets_->actor, batch), MlpPass(nets_->critic1, batch), size(obs), size(obs), size(obs + act), size(1),
+        size(1), size(act), size(act * spec_.actor_heads()), std::vector<int>(batch), std::vector<int>(batch)});
   }
   ExplicitUpdate& e = *explicit_;
+  for (int r = 0; r < batch; ++r) {
+    e.head[r] = spec_.head_of(b.vector.data_ptr<float>() + static_cast<std::ptrdiff_t>(r) * obs);
+    e.next_head[r] = spec_.head_of(b.next_vector.data_ptr<float>() + static_cast<std::ptrdiff_t>(r) * obs);
+  }
+  // Row r's action j among an actor's outputs [heads x A, B].
+  const auto output_of = [&](const std::vector<int>& head, int j, int r) { return (head[r] * act + j) * batch + r; };
   // [B, n] batch-major into [n, B] feature-major.
   const auto transpose_into = [batch](const float* from, int n, float* to) {
     for (int r = 0; r < batch; ++r)
@@ -170,11 +198,11 @@ void Td3::update_with_explicit_passes(const ReplayBatch& b, const torch::Tensor&
   const auto q_of = [&](Mlp& critic) { return e.critic.forward(critic, e.critic_input.data()); };
 
   // Critic target: r + gamma^k (1 - terminated) min(Q1', Q2')(s', pi'(s') + clipped noise).
-  const float* next_a = e.actor.forward(target_->actor, e.next_observation.data());
+  const float* next_outputs = e.actor.forward(target_->actor, e.next_observation.data());
   for (int j = 0; j < act; ++j)
     for (int r = 0; r < batch; ++r) {
-      const int i = j * batch + r;
-      critic_action[i] = std::clamp(std::tanh(next_a[i]) + noise[r * act + j], -1.0f, 1.0f);
+      const float next_a = next_outputs[output_of(e.next_head, j, r)];
+      critic_action[j * batch + r] = std::clamp(std::tanh(next_a) + noise[r * act + j], -1.0f, 1.0f);
     }
   set_critic_observation(e.next_observation);
   std::copy_n(q_of(target_->critic1), batch, e.y.data());
@@ -202,8 +230,10 @@ void Td3::update_with_explicit_passes(const ReplayBatch& b, const torch::Tensor&
   if (counters_.updates % config_.policy_delay != 0) return;
 
   // Delayed actor update: maximise Q1(s, pi(s)) (+ behaviour cloning).
-  float* pi = e.actor.forward(nets_->actor, e.observation.data());
-  for (int i = 0; i < batch * act; ++i) critic_action[i] = pi[i] = std::tanh(pi[i]);
+  const float* outputs = e.actor.forward(nets_->actor, e.observation.data());
+  float* const pi = e.pi.data();
+  for (int j = 0; j < act; ++j)
+    for (int r = 0; r < batch; ++r) critic_action[j * batch + r] = pi[j * batch + r] = std::tanh(outputs[output_of(e.head, j, r)]);
   const float* q = q_of(nets_->critic1);
   // d loss / d q of -mean(q) [/ mean|q|]: the same value for every row.
   double d_mean = -config_.actor_q_weight / batch;
@@ -221,12 +251,13 @@ void Td3::update_with_explicit_passes(const ReplayBatch& b, const torch::Tensor&
   const float* target = b.target.data_ptr<float>();
   const float* has_target = b.has_target.data_ptr<float>();
   const float* d_critic_action = e.critic.input_grad() + static_cast<std::ptrdiff_t>(obs) * batch;
+  if (spec_.head_selector > 0) std::fill(e.actor_output_grad.begin(), e.actor_output_grad.end(), 0.0f);
   for (int j = 0; j < act; ++j)
     for (int r = 0; r < batch; ++r) {
       const int i = j * batch + r;
       float d_pi = d_critic_action[i];
       if (w > 0) d_pi += bc_scale * has_target[r] * (pi[i] - target[r * act + j]);
-      e.actor_output_grad[i] = d_pi * (1.0f - pi[i] * pi[i]);
+      e.actor_output_grad[output_of(e.head, j, r)] = d_pi * (1.0f - pi[i] * pi[i]);
     }
   e.actor.backward(e.actor_output_grad.data(), /*parameter_grads=*/true, /*input_grad=*/false);
   clip_and_step(*actor_optimizer_, config_.max_grad_norm);

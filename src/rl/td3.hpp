@@ -59,7 +59,9 @@ class Td3 final : public OffPolicyLearner {
     std::vector<float> observation, next_observation;  // [observation, B]
     std::vector<float> critic_input;                // [observation + action, B]: the critics' cat
     std::vector<float> y, q_grad;                   // [B]
-    std::vector<float> actor_output_grad;           // [A, B]
+    std::vector<float> pi;                          // [A, B]: the actor's actions, each row's head
+    std::vector<float> actor_output_grad;           // [heads x A, B]
+    std::vector<int> head, next_head;               // [B]: each row's actor head (ObservationSpec::head_selector)
   };
   std::unique_ptr<ExplicitUpdate> explicit_;
   ReplayBatch batch_;  // reused by each update (ReplayBuffer::sample_into)

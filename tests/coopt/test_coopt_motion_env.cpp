@@ -38,6 +38,37 @@ TEST(MotionEnv, DeclaresTheTrainersMotionSpecAndRefusesBadChains) {
   EXPECT_THROW(coopt::MotionEnv(c, kMaxModules + 1), std::invalid_argument);
 }
 
+// trainer.motion_heads_per_chain: the vector ends with a one-hot of the
+// chain's length (2..10 modules), declared as the actor's head selector, and
+// a TD3 motion model gets one head per length; SAC is refused by name.
+TEST(MotionEnv, HeadsPerChainAppendTheChainLengthAsTheHeadSelector) {
+  const std::vector<std::string> sets{"trainer.motion_clearance=true", "trainer.motion_image=false",
+                                      "trainer.motion_heads_per_chain=true"};
+  for (int modules : {2, 6, kMaxModules}) {
+    coopt::MotionEnv env(ci_config(sets), modules);
+    const rl::ObservationSpec s = env.observation_spec();
+    const int lengths = kMaxModules - kMinModules + 1;
+    EXPECT_EQ(s.head_selector, lengths);
+    EXPECT_EQ(s.vector_size, task::obs::kStateSize + env.env().clearance_width() + lengths);
+    rl::Observation o;
+    rl::allocate(s, o);
+    env.seed(5);
+    env.reset(o);
+    EXPECT_EQ(s.head_of(o.vector.data()), modules - kMinModules);
+    float sum = 0;
+    for (int k = 0; k < lengths; ++k) sum += o.vector[s.vector_size - lengths + k];
+    EXPECT_EQ(sum, 1.0f);
+  }
+  std::vector<std::string> sac = sets;
+  sac.push_back("trainer.motion_algo=sac");
+  try {
+    ci_config(sac);
+    ADD_FAILURE() << "SAC with heads per chain was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("trainer.motion_heads_per_chain"), std::string::npos) << e.what();
+  }
+}
+
 TEST(MotionEnv, ScriptedPilotClimbsAndReachesTheTargetThroughIt) {
   coopt::MotionEnv env(ci_config({"env.task.max_steps=3500", "trainer.stair_height=0.04"}), 4);
   rl::Observation o;

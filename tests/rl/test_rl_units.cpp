@@ -701,7 +701,8 @@ TEST(Td3, ActorQWeightZeroLeavesTheActorToImitationAlone) {
 // ReLU or tanh derivative left out) moves the networks apart by orders of
 // magnitude more within the first updates. With and without behaviour cloning
 // (decaying, so that its weight reaches 0), clipping, a batch that is not a
-// power of two, two layers and one.
+// power of two, two layers and one, one actor head and three (a row acting
+// through another head than its next state's).
 // Every tensor of `a` is close to the one under the same key of `b`, in nested
 // archives too; `largest` is the largest absolute difference seen.
 void expect_close_archives(torch::serialize::InputArchive& a, torch::serialize::InputArchive& b,
@@ -732,6 +733,7 @@ struct ExplicitPassCase {
   double max_grad_norm;
   std::vector<int> hidden;
   double actor_q_weight = 1;
+  int heads = 0;  // ObservationSpec::head_selector
 };
 
 class Td3ExplicitPasses : public ::testing::TestWithParam<ExplicitPassCase> {};
@@ -748,16 +750,26 @@ TEST_P(Td3ExplicitPasses, EqualAutogradUpToRounding) {
   c.max_grad_norm = GetParam().max_grad_norm;
   c.actor_q_weight = GetParam().actor_q_weight;
   c.actor_learning_rate = c.critic_learning_rate = 3e-3;
-  rl::Td3 explicit_passes({0, 0, 0, 3}, 2, c, 5), autograd({0, 0, 0, 3}, 2, c, 5);
+  const int heads = GetParam().heads;
+  const rl::ObservationSpec spec{0, 0, 0, 3 + heads, heads};
+  rl::Td3 explicit_passes(spec, 2, c, 5), autograd(spec, 2, c, 5);
   autograd.force_autograd(true);
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  const auto observation = [&] {
+    std::vector<float> v{u(rng), u(rng), u(rng)};
+    if (heads > 0) {
+      v.resize(3 + heads, 0.0f);
+      v[3 + rng() % heads] = 1.0f;
+    }
+    return vector_obs(v);
+  };
   rl::Action a;
   for (int i = 0; i < 300; ++i) {
     a.continuous = {u(rng), u(rng)};
     a.target.clear();
     if (i % 3 == 0) a.target = {u(rng), u(rng)};
-    const rl::Observation o = vector_obs({u(rng), u(rng), u(rng)}), next = vector_obs({u(rng), u(rng), u(rng)});
+    const rl::Observation o = observation(), next = observation();
     const float reward = u(rng);
     for (rl::Td3* t : {&explicit_passes, &autograd}) t->store(o, a, reward, next, i % 7 == 0, false);
   }
@@ -785,7 +797,58 @@ TEST_P(Td3ExplicitPasses, EqualAutogradUpToRounding) {
 INSTANTIATE_TEST_SUITE_P(Cases, Td3ExplicitPasses,
                          ::testing::Values(ExplicitPassCase{0.0, 0.0, {16, 16}}, ExplicitPassCase{2.5, 0.0, {16, 16}},
                                            ExplicitPassCase{2.5, 1.0, {16, 16}}, ExplicitPassCase{0.0, 0.5, {8}},
-                                           ExplicitPassCase{2.5, 0.0, {16, 16}, 0.0}));
+                                           ExplicitPassCase{2.5, 0.0, {16, 16}, 0.0},
+                                           ExplicitPassCase{2.5, 1.0, {16, 16}, 1.0, 3}));
+
+// Actor heads (ObservationSpec::head_selector): a row acts through the head
+// its selector chooses, and trains that head only. Trained on head 0's rows
+// alone, the actor's output weights and biases of heads 1 and 2 stay as they
+// were initialised, bit for bit (their gradient is zero, so Adam does not
+// move them), while head 0's move; and act() answers with the chosen head's
+// outputs: after training, head 0's action differs from head 1's for one
+// state. Both update paths.
+TEST(Td3Heads, ARowActsAndLearnsThroughItsHeadOnly) {
+  for (bool autograd : {false, true}) {
+    rl::Td3Config c;
+    c.hidden_sizes = {16};
+    c.batch_size = 32;
+    c.buffer_size = 500;
+    c.learning_starts = 0;
+    c.random_action_steps = 0;
+    c.policy_delay = 1;
+    c.actor_learning_rate = c.critic_learning_rate = 3e-3;
+    const int heads = 3, actions = 2;
+    rl::Td3 td3({0, 0, 0, 2 + heads, heads}, actions, c, 4);
+    td3.force_autograd(autograd);
+    const rl::Mlp& actor = td3.networks()->actor;
+    const torch::Tensor weight0 = actor->layers().back()->weight.clone(), bias0 = actor->layers().back()->bias.clone();
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    rl::Action a;
+    for (int i = 0; i < 200; ++i) {
+      const float x = u(rng);
+      a.continuous = {u(rng), u(rng)};
+      // A bandit: the reward is highest at action (0.7, -0.7).
+      const float reward = -std::pow(a.continuous[0] - 0.7f, 2.0f) - std::pow(a.continuous[1] + 0.7f, 2.0f);
+      td3.store(vector_obs({x, 1.0f, 1.0f, 0.0f, 0.0f}), a, reward, vector_obs({x, 1.0f, 1.0f, 0.0f, 0.0f}), true, false);
+    }
+    for (int update = 0; update < 300; ++update) td3.update();
+    const torch::Tensor weight = actor->layers().back()->weight, bias = actor->layers().back()->bias;
+    const auto rows = [&](int head) { return torch::indexing::Slice(head * actions, (head + 1) * actions); };
+    EXPECT_FALSE(torch::equal(weight.index({rows(0)}), weight0.index({rows(0)}))) << "autograd " << autograd;
+    EXPECT_FALSE(torch::equal(bias.index({rows(0)}), bias0.index({rows(0)}))) << "autograd " << autograd;
+    for (int head : {1, 2}) {
+      EXPECT_TRUE(torch::equal(weight.index({rows(head)}), weight0.index({rows(head)}))) << "head " << head;
+      EXPECT_TRUE(torch::equal(bias.index({rows(head)}), bias0.index({rows(head)}))) << "head " << head;
+    }
+    rl::Action head0, head1;
+    td3.act(vector_obs({0.2f, 1.0f, 1.0f, 0.0f, 0.0f}), /*explore=*/false, head0);
+    td3.act(vector_obs({0.2f, 1.0f, 0.0f, 1.0f, 0.0f}), /*explore=*/false, head1);
+    EXPECT_GT(head0.continuous[0], 0.4f) << "autograd " << autograd;  // learned towards 0.7
+    EXPECT_LT(head0.continuous[1], -0.4f) << "autograd " << autograd;
+    EXPECT_GT(std::abs(head0.continuous[0] - head1.continuous[0]), 0.2f) << "autograd " << autograd;
+  }
+}
 
 // sample_into reuses its batch's tensors and returns what sample() returns
 // for the same draws, terminated transitions and targets included.
