@@ -136,9 +136,11 @@ void fill_motion(const float* depth, const float* state, const float* clearance,
     const int modules = static_cast<int>(
         std::count_if(state + task::obs::kModuleMask, state + task::obs::kModuleMask + kMaxModules,
                       [](float present) { return present > 0.5f; }));
-    if (modules < kMinModules) throw std::logic_error("fill_motion: a state with " + std::to_string(modules) + " modules");
-    std::fill(o.vector.end() - selector, o.vector.end(), 0.0f);
-    o.vector[o.vector.size() - static_cast<std::size_t>(selector) + static_cast<std::size_t>(modules - kMinModules)] = 1.0f;
+    if (modules < kMinModules)
+      throw std::logic_error("fill_motion: a state with " + std::to_string(modules) + " modules");
+    const auto block = o.vector.end() - selector;
+    std::fill(block, o.vector.end(), 0.0f);
+    block[modules - kMinModules] = 1.0f;
   }
 }
 

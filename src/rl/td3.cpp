@@ -233,7 +233,8 @@ void Td3::update_with_explicit_passes(const ReplayBatch& b, const torch::Tensor&
   const float* outputs = e.actor.forward(nets_->actor, e.observation.data());
   float* const pi = e.pi.data();
   for (int j = 0; j < act; ++j)
-    for (int r = 0; r < batch; ++r) critic_action[j * batch + r] = pi[j * batch + r] = std::tanh(outputs[output_of(e.head, j, r)]);
+    for (int r = 0; r < batch; ++r)
+      critic_action[j * batch + r] = pi[j * batch + r] = std::tanh(outputs[output_of(e.head, j, r)]);
   const float* q = q_of(nets_->critic1);
   // d loss / d q of -mean(q) [/ mean|q|]: the same value for every row.
   double d_mean = -config_.actor_q_weight / batch;

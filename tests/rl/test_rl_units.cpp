@@ -830,7 +830,8 @@ TEST(Td3Heads, ARowActsAndLearnsThroughItsHeadOnly) {
       a.continuous = {u(rng), u(rng)};
       // A bandit: the reward is highest at action (0.7, -0.7).
       const float reward = -std::pow(a.continuous[0] - 0.7f, 2.0f) - std::pow(a.continuous[1] + 0.7f, 2.0f);
-      td3.store(vector_obs({x, 1.0f, 1.0f, 0.0f, 0.0f}), a, reward, vector_obs({x, 1.0f, 1.0f, 0.0f, 0.0f}), true, false);
+      const rl::Observation o = vector_obs({x, 1.0f, 1.0f, 0.0f, 0.0f});  // selector (1, 0, 0): head 0
+      td3.store(o, a, reward, o, /*terminated=*/true, false);
     }
     for (int update = 0; update < 300; ++update) td3.update();
     const torch::Tensor weight = actor->layers().back()->weight, bias = actor->layers().back()->bias;
