@@ -30,7 +30,15 @@ EpisodePlan plan_episode(const TrainerParams& t, int episode) {
   p.random_config = p.warmup || (p.scripted && t.pilot_random_configs) ||
                     (!p.refit && !p.scripted && t.random_config_interval > 0 && episode % t.random_config_interval == 0);
   p.pilot = p.scripted || (t.pilot_labels && !p.refit);
-  p.spec.seed = static_cast<std::uint64_t>(t.seed) * 1000003ULL + static_cast<std::uint64_t>(episode);
+  // The refit's sweep: episode refit_start + kCandidates g + a plays the scene
+  // of episode refit_start + kCandidates g with candidate a first.
+  int scene_episode = episode;
+  const int into_refit = episode - t.refit_start();
+  if (p.refit && into_refit < t.refit_sweep_scenes * kCandidates) {
+    p.first_config = into_refit % kCandidates;
+    scene_episode = episode - p.first_config;
+  }
+  p.spec.seed = static_cast<std::uint64_t>(t.seed) * 1000003ULL + static_cast<std::uint64_t>(scene_episode);
   p.spec.stair_height = t.stair_height;
   const task::ScenarioSpec& scenario = task::scenario_spec(t.scenario);
   p.spec.obstacles = scenario.obstacles;
@@ -253,6 +261,12 @@ void Actor::play(int episode, ActorLink& link) {
   };
   if (plan.random_config)
     hooks.random_config = [this](const std::vector<std::uint8_t>& mask) { return random_valid_action(mask, rng_); };
+  if (plan.first_config >= 0)  // the first decision forced (every candidate is valid from the full chain), then the DQN's
+    hooks.random_config = [first = plan.first_config, decided = false](const std::vector<std::uint8_t>& mask) mutable {
+      const int a = decided || !mask[static_cast<std::size_t>(first)] ? -1 : first;
+      decided = true;
+      return a;
+    };
   if (plan.pilot) {
     hooks.pilot = &pilot_;
     hooks.pilot_drives = plan.scripted;

@@ -57,6 +57,7 @@ struct EpisodePlan {
   bool config_learns = false;  // the DQN learns from this episode's decisions
   bool random_config = false;  // configurations drawn uniformly (warm-up, pilot_random_configs, random_config_interval)
   bool pilot = false;          // the pilot plans: BC targets, and drives when scripted
+  int first_config = -1;       // the refit's sweep (refit_sweep_scenes): the first decision's candidate, else -1
   task::EpisodeSpec spec;      // the scene (seed from trainer.seed and the index)
 };
 EpisodePlan plan_episode(const TrainerParams& t, int episode);

@@ -9,6 +9,7 @@
 #include "sim/params.hpp"
 #include "common/resources.hpp"
 #include "common/yaml_fields.hpp"
+#include "coopt/segment.hpp"
 #include "rl/registry.hpp"
 
 namespace comorph::coopt {
@@ -121,6 +122,9 @@ void add_fields(YamlFields& f, TrainerParams& p) {
         "the DQN's target: bootstrap (Eq. 3) | return (the R2 of the rest of the episode)");
   f.add("config_refit_episodes", &p.config_refit_episodes, 0, kMaxEpisodes,
         "then this many episodes in which a fresh DQN (dqn_refit:) learns on the frozen greedy motion model");
+  f.add("refit_sweep_scenes", &p.refit_sweep_scenes, 0, kMaxEpisodes,
+        "the refit's first this-many x 9 episodes play each scene once per chain length, the first configuration "
+        "forced in turn (every chain on the same scenes); 0 = none");
   f.add("refit_motion_from", &p.refit_motion_from,
         "a trained run whose motion model this run takes, frozen, to do only a refit (warm-up and episodes 0)");
   f.add("scene_source", &p.scene_source,
@@ -175,6 +179,11 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
     // A run without a single episode would end at once with no checkpoint to resume or evaluate.
     fail(source, pre + ".episodes", "warmup_episodes + episodes must be at least 1");
   }
+  if (p.refit_sweep_scenes * kCandidates > p.config_refit_episodes)
+    fail(source, pre + ".refit_sweep_scenes",
+         std::to_string(p.refit_sweep_scenes) + " scenes x " + std::to_string(kCandidates) +
+             " chain lengths is more than trainer.config_refit_episodes (" + std::to_string(p.config_refit_episodes) +
+             ")");
   if (p.config_refit_episodes > 0 && p.mode != TrainerMode::hierarchical)
     fail(source, pre + ".config_refit_episodes", "needs trainer.mode hierarchical (a fixed chain has no DQN)");
   // Whether the directory holds a classifier is checked where it is loaded

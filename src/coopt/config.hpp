@@ -114,6 +114,13 @@ struct TrainerParams {
   // uniformly too (0 = none): the motion model keeps practising every chain
   // length without a pilot, instead of only the one the DQN settles on.
   int random_config_interval = 0;
+  // The refit's first refit_sweep_scenes x 9 episodes play each of that many
+  // scenes once per chain length, the first configuration forced in turn (the
+  // later ones the DQN's). Every (stair height, chain) pair then gets samples
+  // in proportion, and the chains' returns share each scene's luck (common
+  // random numbers), instead of ~10 epsilon-greedy draws of independent
+  // scenes each. 0 = none.
+  int refit_sweep_scenes = 0;
   // The pilot climbs with each chain length's own searched gait
   // (task::searched_stair_gaits); false: one gait (a0, a2, a3, a4) = (1, 1, -0.5, 1) for all.
   bool pilot_gait_per_modules = false;

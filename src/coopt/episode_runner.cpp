@@ -53,7 +53,7 @@ rl::ObservationSpec motion_spec(const CooptConfig& c) {
   s.vector_size =
       task::obs::kStateSize + (c.trainer.motion_clearance ? task::MultiTaskEnv::clearance_width(c.env.robot) : 0);
   if (c.trainer.motion_heads_per_chain) {
-    s.head_selector = kMaxModules - kMinModules + 1;
+    s.head_selector = kCandidates;  // the chain lengths
     s.vector_size += s.head_selector;
   }
   return s;
@@ -128,7 +128,7 @@ void fill_motion(const float* depth, const float* state, const float* clearance,
     }
     o.vector[static_cast<std::size_t>(i)] = v;
   }
-  const int selector = t.motion_heads_per_chain ? kMaxModules - kMinModules + 1 : 0;
+  const int selector = t.motion_heads_per_chain ? kCandidates : 0;
   const auto rest = o.vector.begin() + task::obs::kStateSize;  // the clearance row, then the head selector
   if (t.motion_clearance) std::copy(clearance, clearance + (o.vector.end() - rest - selector), rest);
   if (selector > 0) {

@@ -289,6 +289,34 @@ TEST(Trainer, ConfigRefitTrainsAFreshDqnOnTheFrozenMotionModel) {
   fs::remove_all(dir);
 }
 
+// trainer.refit_sweep_scenes: the refit's first 9 episodes play one scene
+// (seed and stair height) with the first chain forced to 2, 3, ..., 10
+// modules in turn; the DQN learns from those decisions as from any refit
+// decision; the refit's later episodes play their own scenes.
+TEST(Trainer, RefitSweepPlaysOneSceneWithEveryChainLengthFirst) {
+  std::vector<std::string> sets = kWithDemonstrations;
+  sets.insert(sets.end(), {"trainer.config_refit_episodes=" + std::to_string(kCandidates + 1),
+                           "trainer.refit_sweep_scenes=1"});
+  const std::string dir = temp_dir("refit_sweep");
+  const RunResult r = run_ci(sets, dir);
+  const int start = load_coopt_config(kCi, sets).trainer.refit_start();
+  ASSERT_EQ(static_cast<int>(r.logs.size()), start + kCandidates + 1);
+  for (int a = 0; a < kCandidates; ++a) {
+    const EpisodeLog& l = r.logs[static_cast<std::size_t>(start + a)];
+    ASSERT_FALSE(l.configurations.empty());
+    EXPECT_EQ(l.configurations.front(), modules_of(a)) << "refit episode " << a;
+    EXPECT_EQ(l.seed, r.logs[static_cast<std::size_t>(start)].seed);
+    EXPECT_EQ(l.stair_height_m, r.logs[static_cast<std::size_t>(start)].stair_height_m);
+  }
+  EXPECT_NE(r.logs.back().seed, r.logs[static_cast<std::size_t>(start)].seed);
+  int refit_decisions = 0;
+  for (const DecisionLog& d : r.decisions) refit_decisions += d.episode >= start;
+  EXPECT_GE(refit_decisions, kCandidates);
+  EXPECT_THROW(load_coopt_config(kCi, {"trainer.config_refit_episodes=8", "trainer.refit_sweep_scenes=1"}),
+               std::runtime_error);
+  fs::remove_all(dir);
+}
+
 TEST(Trainer, ResumeAfterInterruptionContinuesTheSameEpisodesWithIdenticalResults) {
   const std::vector<std::string> sets{"trainer.episodes=6", "trainer.checkpoint_interval=3"};
   // The data rows of the episodes.csv the trainer writes (RunStore).

@@ -64,6 +64,35 @@ TEST(EpisodePlan, RandomConfigIntervalDrawsEveryKthTrainingEpisodesChainsButNeve
   EXPECT_FALSE(plan_episode(t, 5).pilot);
 }
 
+// trainer.refit_sweep_scenes: the refit's first scenes x 9 episodes come in
+// groups of 9 on one scene each, the first configuration forced to each
+// candidate in turn; the rest of the refit, and everything before it, plays
+// its own scene with the DQN's choice. The forced choice applies to the
+// episode's first decision only.
+TEST(EpisodePlan, RefitSweepPlaysEachSceneOncePerChainLength) {
+  TrainerParams t;
+  t.warmup_episodes = 2;
+  t.episodes = 3;
+  t.config_refit_episodes = 2 * kCandidates + 4;
+  t.refit_sweep_scenes = 2;
+  const int start = t.refit_start();
+  for (int e = 0; e < t.total_episodes(); ++e) {
+    const EpisodePlan p = plan_episode(t, e);
+    const int into = e - start;
+    if (into >= 0 && into < 2 * kCandidates) {
+      EXPECT_EQ(p.first_config, into % kCandidates) << e;
+      EXPECT_EQ(p.spec.seed, plan_episode(t, start + into / kCandidates * kCandidates).spec.seed) << e;
+    } else {
+      EXPECT_EQ(p.first_config, -1) << e;
+    }
+  }
+  EXPECT_NE(plan_episode(t, start).spec.seed, plan_episode(t, start + kCandidates).spec.seed);
+  EXPECT_NE(plan_episode(t, start + 2 * kCandidates).spec.seed, plan_episode(t, start).spec.seed);
+  t.refit_sweep_scenes = 0;
+  for (int e = 0; e < t.total_episodes(); ++e) EXPECT_EQ(plan_episode(t, e).first_config, -1);
+  EXPECT_NE(plan_episode(t, start + 1).spec.seed, plan_episode(t, start).spec.seed);
+}
+
 TEST(Segment, DecisionReturnsSumTheLaterSegmentsDiscountedOncePerDecision) {
   std::vector<float> r2{300.0f, 500.0f, -10.0f};
   to_decision_returns(r2, 0.5);
