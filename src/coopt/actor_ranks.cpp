@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
+#include <string>
 #include <thread>
 
 #include "rl/learner.hpp"
@@ -21,17 +22,18 @@ void check(int code, const char* what) {
   if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI: ") + what + " failed");
 }
 
-// Waits for a message from `source` (any tag) without spinning on the core
-// (MPI's blocking receive polls it at 100 %): sleeps from 20 us, doubling
-// up to `longest`. The host waits a whole round for rollouts (1 ms: a
-// wake-up a millisecond); an actor waits while the host closes the round,
-// and its wake-up delays the next round (200 us).
-MPI_Status wait_for_message(int source, std::chrono::microseconds longest) {
+// Waits for a message from `source` (MPI_ANY_SOURCE: any rank) with `tag`
+// (MPI_ANY_TAG: any) without spinning on the core (MPI's blocking receive
+// polls it at 100 %): sleeps from 20 us, doubling up to `longest`. The host
+// waits a whole round for rollouts (1 ms: a wake-up a millisecond); an actor
+// waits while the host closes the round, and its wake-up delays the next
+// round (200 us).
+MPI_Status wait_for_message(int source, int tag, std::chrono::microseconds longest) {
   MPI_Status status;
   int arrived = 0;
   auto nap = std::chrono::microseconds(20);
   while (true) {
-    check(MPI_Iprobe(source, MPI_ANY_TAG, MPI_COMM_WORLD, &arrived, &status), "MPI_Iprobe");
+    check(MPI_Iprobe(source, tag, MPI_COMM_WORLD, &arrived, &status), "MPI_Iprobe");
     if (arrived) return status;
     std::this_thread::sleep_for(nap);
     nap = std::min(2 * nap, longest);
@@ -45,28 +47,32 @@ void receive(int source, const MPI_Status& status, std::vector<char>& bytes) {
   check(MPI_Recv(bytes.data(), size, MPI_BYTE, source, status.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE), "MPI_Recv");
 }
 
-void send(const std::vector<char>& bytes, int dest, int tag) {
-  check(MPI_Send(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, dest, tag, MPI_COMM_WORLD), "MPI_Send");
-}
-
 // An actor rank's side: the host is rank 0.
 class RankLink final : public ActorLink {
  public:
   void exchange(Rollout* rollout, const ActingWeights*& weights, const Orders*& orders) override {
+    // The rollout goes without blocking: a message this size waits for the
+    // host's receive (rendezvous), and a blocking send would spin this core
+    // until then, away from the other actors and the learner.
+    MPI_Request sent = MPI_REQUEST_NULL;
     if (rollout) {
-      rollout_to_bytes(*rollout, bytes_);
-      send(bytes_, 0, kRollout);
+      rollout_to_bytes(*rollout, rollout_bytes_);
+      check(MPI_Isend(rollout_bytes_.data(), static_cast<int>(rollout_bytes_.size()), MPI_BYTE, 0, kRollout,
+                      MPI_COMM_WORLD, &sent),
+            "MPI_Isend");
     }
-    const MPI_Status status = wait_for_message(0, std::chrono::microseconds(200));
-    receive(0, status, bytes_);
+    const MPI_Status status = wait_for_message(0, MPI_ANY_TAG, std::chrono::microseconds(200));
+    receive(0, status, release_bytes_);
+    // The host releases a round only after it received every rollout: done.
+    check(MPI_Wait(&sent, MPI_STATUS_IGNORE), "MPI_Wait");
     if (status.MPI_TAG == kStop) throw ActorStopped{};
-    release_from_bytes(bytes_, weights_, orders_);
+    release_from_bytes(release_bytes_, weights_, orders_);
     weights = &weights_;
     orders = &orders_;
   }
 
  private:
-  std::vector<char> bytes_;
+  std::vector<char> rollout_bytes_, release_bytes_;
   ActingWeights weights_;
   Orders orders_;
 };
@@ -129,14 +135,20 @@ std::vector<Rollout*>& ActorRanks::round(const ActingWeights& weights, const std
     motion_version_[i] = weights.motion_version;
     config_version_[i] = weights.config_version;
   }
-  for (int i = 0; i < actors(); ++i) {
-    rollouts_[static_cast<std::size_t>(i)] = nullptr;
-    if (orders[static_cast<std::size_t>(i)].episode < 0) continue;
-    const MPI_Status status = wait_for_message(i + 1, std::chrono::microseconds(1000));
-    receive(i + 1, status, bytes_);
-    Rollout& r = received_[static_cast<std::size_t>(i)];
-    rollout_from_bytes(bytes_, r);
-    rollouts_[static_cast<std::size_t>(i)] = &r;
+  // The rollouts in the order they arrive (each actor's send waits for this
+  // receive), each into its actor's place: the round's order is the actors'.
+  int expected = 0;
+  for (std::size_t i = 0; i < received_.size(); ++i) {
+    rollouts_[i] = nullptr;
+    expected += orders[i].episode >= 0;
+  }
+  for (; expected > 0; --expected) {
+    const MPI_Status status = wait_for_message(MPI_ANY_SOURCE, kRollout, std::chrono::microseconds(1000));
+    receive(status.MPI_SOURCE, status, bytes_);
+    const auto i = static_cast<std::size_t>(status.MPI_SOURCE - 1);
+    if (rollouts_[i]) throw std::logic_error("actor rank " + std::to_string(i + 1) + " sent two rollouts in a round");
+    rollout_from_bytes(bytes_, received_[i]);
+    rollouts_[i] = &received_[i];
   }
   // Done by now (the probes above moved them on): the buffers are free again.
   check(MPI_Waitall(static_cast<int>(sends_.size()), sends_.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");

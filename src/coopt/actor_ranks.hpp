@@ -1,9 +1,10 @@
 // The acting protocol's transport between the ranks of an MPI job
 // (coopt/acting.hpp): rank 0 is the learner host, ranks 1..K-1 are actors.
 // A round: the host sends each actor rank the weights and its orders as one
-// message, then receives the rollout of each actor with an episode, in actor
-// order (the values as bytes: rollout_to_bytes, release_to_bytes). Waiting
-// polls with growing sleeps, so a waiting rank leaves its core to the others.
+// message, then receives the rollout of each actor with an episode as they
+// arrive, and hands them on in actor order (the values as bytes:
+// rollout_to_bytes, release_to_bytes). Sends do not block and waiting polls
+// with growing sleeps, so a waiting rank leaves its core to the others.
 // Internal to coopt; the public face is coopt/trainer.hpp (MpiJob,
 // ActorPlacement, serve_actor_rank).
 #pragma once
