@@ -31,7 +31,7 @@ std::vector<float> q_values_of(QNetwork& q, const ObservationSpec& spec, int num
 // observation's valid actions (the random choice uniform among them).
 void act_with(QNetwork& q, const ObservationSpec& spec, int num_actions, const DqnConfig& c,
               const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng,
-              std::vector<float>& /*noise: unused*/, const Observation& o, bool explore, Action& action) {
+              ActingState& /*state: unused*/, const Observation& o, bool explore, Action& action) {
   const auto& mask = o.valid_actions;
   if (!mask.empty() && static_cast<int>(mask.size()) != num_actions)
     throw std::invalid_argument("Dqn::act: valid_actions has " + std::to_string(mask.size()) +
@@ -71,7 +71,7 @@ double Dqn::epsilon() const { return epsilon_at(config_, counters_); }
 std::vector<float> Dqn::q_values(const Observation& o) { return q_values_of(q_, spec_, num_actions_, device_, o); }
 
 void Dqn::act(const Observation& o, bool explore, Action& action) {
-  act_with(q_, spec_, num_actions_, config_, device_, counters_, rng_, acting_noise_, o, explore, action);
+  act_with(q_, spec_, num_actions_, config_, device_, counters_, rng_, acting_, o, explore, action);
 }
 
 torch::Tensor Dqn::td_target(const ReplayBatch& b) {

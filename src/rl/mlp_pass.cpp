@@ -8,6 +8,7 @@
 #include "rl/flat_adam.hpp"
 
 namespace comorph::rl {
+
 bool MlpPass::supports(const Mlp& net) {
   for (const auto& layer : net->layers())
     if (!is_plain_cpu_float(layer->weight) || !is_plain_cpu_float(layer->bias)) return false;
@@ -78,6 +79,27 @@ void MlpPass::backward(const float* output_grad, bool parameter_grads, bool inpu
       for (std::size_t i = 0; i < grads_[k].size(); ++i) dx[i] = x[i] > 0.0f ? dx[i] : 0.0f;
     g = dx;
   }
+}
+
+const float* MlpRow::forward(const Mlp& net, const float* input) {
+  const auto& layers = net->layers();
+  std::size_t widest = static_cast<std::size_t>(layers.front()->weight.size(1));
+  for (const auto& layer : layers) widest = std::max(widest, static_cast<std::size_t>(layer->weight.size(0)));
+  if (from_.size() < widest) from_.resize(widest), to_.resize(widest);
+  const float* x = input;
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    const int in = static_cast<int>(layers[i]->weight.size(1)), out = static_cast<int>(layers[i]->weight.size(0));
+    float* y = (i % 2 == 0 ? to_ : from_).data();
+    const float* bias = layers[i]->bias.data_ptr<float>();
+    std::copy(bias, bias + out, y);
+    // addmm's call for [1, in] x W^T: column-major y [out, 1] = W^T' x + y.
+    cblas_sgemm(CblasColMajor, CblasTrans, CblasNoTrans, out, 1, in, 1.0f, layers[i]->weight.data_ptr<float>(), in, x,
+                in, 1.0f, y, out);
+    if (i + 1 < layers.size())
+      for (int o = 0; o < out; ++o) y[o] = std::max(y[o], 0.0f);
+    x = y;
+  }
+  return x;
 }
 
 }  // namespace comorph::rl

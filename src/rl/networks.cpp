@@ -120,12 +120,16 @@ torch::Tensor image_batch(const Observation& o, const ObservationSpec& spec,
       .to(device);
 }
 
-torch::Tensor vector_batch(const Observation& o, const ObservationSpec& spec,
-                           const torch::Device& device) {
-  if (!spec.has_vector()) return {};
+void check_vector_size(const Observation& o, const ObservationSpec& spec) {
   if (static_cast<int>(o.vector.size()) != spec.vector_size)
     throw std::invalid_argument("observation vector has " + std::to_string(o.vector.size()) +
                                 " values, expected " + std::to_string(spec.vector_size));
+}
+
+torch::Tensor vector_batch(const Observation& o, const ObservationSpec& spec,
+                           const torch::Device& device) {
+  if (!spec.has_vector()) return {};
+  check_vector_size(o, spec);
   return torch::from_blob(const_cast<float*>(o.vector.data()), {1, spec.vector_size},
                           torch::kFloat32)
       .to(device);

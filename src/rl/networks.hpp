@@ -120,5 +120,7 @@ torch::Tensor image_batch(const Observation& observation, const ObservationSpec&
                           const torch::Device& device);
 torch::Tensor vector_batch(const Observation& observation, const ObservationSpec& spec,
                            const torch::Device& device);
+// Throws unless the observation's vector has the spec's size.
+void check_vector_size(const Observation& observation, const ObservationSpec& spec);
 
 }  // namespace comorph::rl

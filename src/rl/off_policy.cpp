@@ -56,7 +56,7 @@ void OffPolicyLearner::store(const Observation& o, const Action& action, float r
   ++counters_.transitions;
   if (terminated || truncated) {
     ++counters_.episodes;
-    acting_noise_.clear();
+    acting_.start_episode();
   }
 }
 

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "rl/acting_state.hpp"
 #include "rl/flat_adam.hpp"
 #include "rl/learner.hpp"
 #include "rl/networks.hpp"
@@ -38,22 +39,29 @@ bool random_warmup_action(std::int64_t random_action_steps, std::int64_t random_
                           const LearnerCounters& counters, bool explore, std::mt19937_64& rng, Action& action);
 
 // The acting rule TD3 and SAC share, for the learner and its Policy: a uniform
-// action during the random-action warm-up (returns false), else the 1 x
-// action_dims tensor `actor_output()` (run under InferenceMode) copied into
-// action.continuous (returns true).
+// action during the random-action warm-up (returns false), else the actor's
+// action_dims values, which `actor_output(out)` writes into action.continuous
+// (returns true).
 template <typename Config, typename ActorOutput>
 bool act_continuous(const Config& c, int action_dims, const LearnerCounters& counters, bool explore,
                     std::mt19937_64& rng, Action& action, ActorOutput&& actor_output) {
   action.continuous.resize(action_dims);
   if (random_warmup_action(c.random_action_steps, c.random_action_episodes, counters, explore, rng, action))
     return false;
+  actor_output(action.continuous.data());
+  return true;
+}
+
+// The values of a [1, n] action tensor that `compute()` makes (under
+// InferenceMode), copied into `out`.
+template <typename Compute>
+void copy_tensor_action(Compute&& compute, float* out) {
   torch::Tensor a;
   {
     torch::InferenceMode guard;
-    a = actor_output().to(torch::kCPU);
+    a = compute().to(torch::kCPU);
   }
-  std::copy(a.data_ptr<float>(), a.data_ptr<float>() + action_dims, action.continuous.begin());
-  return true;
+  std::copy(a.data_ptr<float>(), a.data_ptr<float>() + a.numel(), out);
 }
 
 // One gradient step: zero_grad, backward, the gradient's L2 norm clipped to
@@ -157,7 +165,7 @@ class OffPolicyLearner : public Learner {
   torch::Device device_;
   ReplayBuffer replay_;
   std::mt19937_64 rng_;  // replay sampling, exploration, the algorithm's noise
-  std::vector<float> acting_noise_;  // act()'s noise state within an episode (Policy's noise_)
+  ActingState acting_;  // act()'s noise state within an episode and its buffers (as a Policy's)
   LearnerCounters counters_;
   double last_loss_ = 0;
 

@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "rl/acting_state.hpp"
 #include "rl/env.hpp"
 #include "rl/learner.hpp"
 
@@ -36,7 +37,7 @@ class Policy {
     ++counters_.transitions;
     if (terminated || truncated) {
       ++counters_.episodes;
-      noise_.clear();  // the next episode's exploration noise starts afresh
+      acting_.start_episode();  // the next episode's exploration noise starts afresh
     }
   }
   // Copies the learner's acting networks (Learner::acting_networks) into this copy.
@@ -54,14 +55,14 @@ class Policy {
   void set_counters(const LearnerCounters& counters) { counters_ = counters; }
   void reseed(std::uint64_t seed) {
     rng_.seed(seed);
-    noise_.clear();
+    acting_.start_episode();
   }
   // The RNG as a value: an acting copy that continues another's random stream
   // (coopt's one-actor schedule) is handed it and hands it back.
   const std::mt19937_64& rng() const { return rng_; }
   void set_rng(const std::mt19937_64& rng) {
     rng_ = rng;
-    noise_.clear();
+    acting_.start_episode();
   }
 
  protected:
@@ -74,9 +75,8 @@ class Policy {
 
   LearnerCounters counters_;
   std::mt19937_64 rng_;
-  // The acting rule's noise state within an episode (TD3's coloured
-  // exploration noise; empty at an episode's start, unused by the others).
-  std::vector<float> noise_;
+  // The acting rule's noise state within an episode and its buffers.
+  ActingState acting_;
 
  private:
   std::string algorithm_, key_, device_;
@@ -94,14 +94,14 @@ class NetworkPolicy final : public Policy {
  public:
   using Rule = void (*)(Net& net, const ObservationSpec& spec, int actions, const Config& config,
                         const torch::Device& device, const LearnerCounters& counters, std::mt19937_64& rng,
-                        std::vector<float>& noise, const Observation& observation, bool explore, Action& action);
+                        ActingState& state, const Observation& observation, bool explore, Action& action);
   // `actions`: action dimensions (continuous) or count (discrete).
   NetworkPolicy(std::string algorithm, std::string networks_key, const ObservationSpec& spec, int actions,
                 const Config& config, std::uint64_t seed, Net net, Rule rule)
       : Policy(std::move(algorithm), std::move(networks_key), config.device, seed), spec_(spec), actions_(actions),
         config_(config), device_(config.device), net_(std::move(net)), rule_(rule) {}
   void act(const Observation& observation, bool explore, Action& action) override {
-    rule_(net_, spec_, actions_, config_, device_, counters_, rng_, noise_, observation, explore, action);
+    rule_(net_, spec_, actions_, config_, device_, counters_, rng_, acting_, observation, explore, action);
   }
 
  protected:

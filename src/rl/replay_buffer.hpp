@@ -51,8 +51,8 @@ class ReplayBuffer {
   ReplayBatch sample(std::int64_t batch_size, std::mt19937_64& rng,
                      const torch::Device& device) const;
   // As sample(), into `batch`, whose tensors are allocated at the first call
-  // and reused after (one [B] temporary remains, the gathered discount). For a
-  // vector observation on the CPU; otherwise it assigns sample()'s batch.
+  // and reused after (no allocation, no LibTorch operation). For a vector
+  // observation on the CPU; otherwise it assigns sample()'s batch.
   // The same draws from `rng`, the same values.
   void sample_into(ReplayBatch& batch, std::int64_t batch_size, std::mt19937_64& rng,
                    const torch::Device& device) const;

@@ -40,11 +40,15 @@ std::pair<torch::Tensor, torch::Tensor> sample_action(ActorCritic& nets, const S
 // random-action warm-up, else a sample of the squashed Gaussian (exploring) or its mean.
 void act_with(ActorCritic& nets, const ObservationSpec& spec, int action_dims, const SacConfig& c,
               const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng,
-              std::vector<float>& /*noise: unused*/, const Observation& o, bool explore, Action& action) {
-  act_continuous(c, action_dims, n, explore, rng, action, [&] {
-    const torch::Tensor f = actor_features_of(nets, o, spec, device);
-    if (explore) return sample_action(nets, c, action_dims, f, rng, device).first;
-    return torch::tanh(nets->actor_head(f).slice(1, 0, action_dims));  // the mean action
+              ActingState& /*state: unused*/, const Observation& o, bool explore, Action& action) {
+  act_continuous(c, action_dims, n, explore, rng, action, [&](float* out) {
+    copy_tensor_action(
+        [&] {
+          const torch::Tensor f = actor_features_of(nets, o, spec, device);
+          if (explore) return sample_action(nets, c, action_dims, f, rng, device).first;
+          return torch::tanh(nets->actor_head(f).slice(1, 0, action_dims));  // the mean action
+        },
+        out);
   });
 }
 
@@ -66,7 +70,7 @@ Sac::Sac(const ObservationSpec& observation, int action_dims, const SacConfig& c
 double Sac::alpha() const { return std::exp(log_alpha_.item<double>()); }
 
 void Sac::act(const Observation& o, bool explore, Action& action) {
-  act_with(nets_, spec_, action_dims_, config_, device_, counters_, rng_, acting_noise_, o, explore, action);
+  act_with(nets_, spec_, action_dims_, config_, device_, counters_, rng_, acting_, o, explore, action);
 }
 
 void Sac::update() {

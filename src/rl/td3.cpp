@@ -55,27 +55,51 @@ void step_unit_noise(double rho, int action_dims, std::mt19937_64& rng, std::vec
   for (float& v : z) v = r * v + innovation * normal(rng);
 }
 
+// tanh of the actor's output (its chosen head's) for one vector observation
+// on the CPU: the row pass, then LibTorch's tanh on preallocated tensors; the
+// same bits as the tensor path, without its dispatch.
+void squashed_actor_row(ActorCritic& nets, const ObservationSpec& spec, int action_dims, const Observation& o,
+                        ActingState& state, float* out) {
+  check_vector_size(o, spec);
+  const float* outputs = state.actor.forward(nets->actor, o.vector.data());
+  const int head = spec.head_selector == 0 ? 0 : spec.head_of(o.vector.data());
+  torch::InferenceMode guard;
+  if (!state.head_output.defined()) {
+    state.head_output = torch::empty({1, action_dims});
+    state.squashed = torch::empty({1, action_dims});
+  }
+  std::copy_n(outputs + head * action_dims, action_dims, state.head_output.data_ptr<float>());
+  at::tanh_out(state.squashed, state.head_output);
+  std::copy_n(state.squashed.data_ptr<float>(), action_dims, out);
+}
+
 // The acting rule of the learner and of its Policy: random actions during the
 // random-action warm-up, else tanh(actor) plus clipped noise when exploring.
 // With exploration_noise_correlation 0 both are white (uniform actions,
 // Gaussian noise); with rho > 0 both follow the AR(1) process above (the
 // warm-up's action erf(z / sqrt 2) is uniform in [-1, 1] at every step).
 void act_with(ActorCritic& nets, const ObservationSpec& spec, int action_dims, const Td3Config& c,
-              const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng, std::vector<float>& noise,
+              const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng, ActingState& state,
               const Observation& o, bool explore, Action& action) {
   const double rho = c.exploration_noise_correlation;
   if (explore && rho > 0 && in_random_warmup(c.random_action_steps, c.random_action_episodes, n)) {
     action.continuous.resize(static_cast<std::size_t>(action_dims));
-    step_unit_noise(rho, action_dims, rng, noise);
+    step_unit_noise(rho, action_dims, rng, state.noise);
     for (int i = 0; i < action_dims; ++i)
-      action.continuous[i] = static_cast<float>(std::erf(noise[i] / std::sqrt(2.0)));
+      action.continuous[i] = static_cast<float>(std::erf(state.noise[i] / std::sqrt(2.0)));
     return;
   }
-  const bool from_actor = act_continuous(c, action_dims, n, explore, rng, action, [&] {
-    const torch::Tensor outputs = nets->actor_head(actor_features_of(nets, o, spec, device));
-    if (spec.head_selector == 0) return torch::tanh(outputs);
-    const int head = spec.head_of(o.vector.data());
-    return torch::tanh(outputs.slice(1, head * action_dims, (head + 1) * action_dims));
+  const bool from_actor = act_continuous(c, action_dims, n, explore, rng, action, [&](float* out) {
+    if (!spec.has_image() && device.is_cpu() && MlpPass::supports(nets->actor))
+      return squashed_actor_row(nets, spec, action_dims, o, state, out);
+    copy_tensor_action(
+        [&] {
+          const torch::Tensor outputs = nets->actor_head(actor_features_of(nets, o, spec, device));
+          if (spec.head_selector == 0) return torch::tanh(outputs);
+          const int head = spec.head_of(o.vector.data());
+          return torch::tanh(outputs.slice(1, head * action_dims, (head + 1) * action_dims));
+        },
+        out);
   });
   if (!from_actor || !explore) return;
   if (rho <= 0) {
@@ -83,10 +107,10 @@ void act_with(ActorCritic& nets, const ObservationSpec& spec, int action_dims, c
     for (float& v : action.continuous) v = std::clamp(v + normal(rng), -1.0f, 1.0f);
     return;
   }
-  step_unit_noise(rho, action_dims, rng, noise);
+  step_unit_noise(rho, action_dims, rng, state.noise);
   const auto std = static_cast<float>(noise_std(c, n));
   for (int i = 0; i < action_dims; ++i)
-    action.continuous[i] = std::clamp(action.continuous[i] + std * noise[i], -1.0f, 1.0f);
+    action.continuous[i] = std::clamp(action.continuous[i] + std * state.noise[i], -1.0f, 1.0f);
 }
 
 }  // namespace
@@ -110,7 +134,7 @@ double Td3::bc_weight_now() const {
 }
 
 void Td3::act(const Observation& o, bool explore, Action& action) {
-  act_with(nets_, spec_, action_dims_, config_, device_, counters_, rng_, acting_noise_, o, explore, action);
+  act_with(nets_, spec_, action_dims_, config_, device_, counters_, rng_, acting_, o, explore, action);
 }
 
 void Td3::update() {

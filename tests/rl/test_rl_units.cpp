@@ -851,6 +851,46 @@ TEST(Td3Heads, ARowActsAndLearnsThroughItsHeadOnly) {
   }
 }
 
+// TD3 acts on a vector observation through the row pass (rl::MlpRow) and
+// LibTorch's tanh on preallocated tensors, not through the modules' forward:
+// the actions must be the modules' bit for bit, or a run's actions (and the
+// shipped runs' evaluations) would change with the speed-up. Pendulum's
+// sizes, the presets' motion model's, and actor heads (the chosen head's).
+TEST(Td3, ActsAsTheActorModulesComputeBitForBit) {
+  struct Case {
+    int vector, heads, actions;
+    std::vector<int> hidden;
+  };
+  for (const Case& k : {Case{3, 0, 1, {64, 64}}, Case{70, 0, 5, {128, 128}}, Case{70, 9, 5, {128, 128}}}) {
+    rl::Td3Config c;
+    c.hidden_sizes = k.hidden;
+    c.random_action_steps = 0;
+    rl::Td3 td3({0, 0, 0, k.vector, k.heads}, k.actions, c, 7);
+    rl::Mlp actor = td3.networks()->actor;
+    std::mt19937_64 rng(11);
+    std::normal_distribution<float> normal(0.0f, 1.0f);
+    int differing = 0;
+    rl::Action a;
+    for (int i = 0; i < 500; ++i) {
+      std::vector<float> x(static_cast<std::size_t>(k.vector));
+      for (float& v : x) v = normal(rng);
+      int head = 0;
+      if (k.heads > 0) {
+        head = i % k.heads;
+        std::fill(x.end() - k.heads, x.end(), 0.0f);
+        x[static_cast<std::size_t>(k.vector - k.heads + head)] = 1.0f;
+      }
+      td3.act(vector_obs(x), /*explore=*/false, a);
+      torch::NoGradGuard no_grad;
+      const torch::Tensor expected =
+          torch::tanh(actor->forward(torch::from_blob(x.data(), {1, k.vector}).clone())
+                          .slice(1, head * k.actions, (head + 1) * k.actions));
+      for (int j = 0; j < k.actions; ++j) differing += a.continuous[j] != expected[0][j].item<float>();
+    }
+    EXPECT_EQ(differing, 0) << "vector " << k.vector << ", heads " << k.heads;
+  }
+}
+
 // sample_into reuses its batch's tensors and returns what sample() returns
 // for the same draws, terminated transitions and targets included.
 TEST(ReplayBuffer, SampleIntoEqualsSample) {
