@@ -62,7 +62,7 @@ void squashed_actor_row(ActorCritic& nets, const ObservationSpec& spec, int acti
                         ActingState& state, float* out) {
   check_vector_size(o, spec);
   const float* outputs = state.actor.forward(nets->actor, o.vector.data());
-  const int head = spec.head_selector == 0 ? 0 : spec.head_of(o.vector.data());
+  const int head = spec.head_of(o.vector.data());  // 0 without heads
   torch::InferenceMode guard;
   if (!state.head_output.defined()) {
     state.head_output = torch::empty({1, action_dims});
@@ -198,7 +198,7 @@ void Td3::update_with_explicit_passes(const ReplayBatch& b, const torch::Tensor&
         size(1), size(act), size(act * spec_.actor_heads()), std::vector<int>(batch), std::vector<int>(batch)});
   }
   ExplicitUpdate& e = *explicit_;
-  for (int r = 0; r < batch; ++r) {
+  for (int r = 0; r < batch && spec_.head_selector > 0; ++r) {  // else every row's head stays 0
     e.head[r] = spec_.head_of(b.vector.data_ptr<float>() + static_cast<std::ptrdiff_t>(r) * obs);
     e.next_head[r] = spec_.head_of(b.next_vector.data_ptr<float>() + static_cast<std::ptrdiff_t>(r) * obs);
   }
