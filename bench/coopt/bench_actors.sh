@@ -5,18 +5,21 @@
 # in alternating rounds so that a drift of the machine's speed hits all
 # alike; then the learner's ingest ceiling: transitions/s it stores and
 # trains on at the preset's update ratio (bench_trainer's "learner alone").
-# Ratios measured in one run; the median of the rounds.
-# usage: bench_actors [ROUNDS]   (installed as build/bench/coopt/bench_actors)
+# Ratios measured in one run; the median of the rounds. EPISODES (4) sets the
+# trainings' length after their warm-up episode: longer runs weigh each
+# process's start-up (the ranks pay it once per rank) less.
+# usage: bench_actors [ROUNDS] [EPISODES]   (installed as build/bench/coopt/bench_actors)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 build=$(cd "$here/../.." && pwd)
 exe=$build/apps/comorph
 rounds=${1:-2}
+episodes=${2:-4}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1  # as root
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-# 1 + 4 episodes of at most 1000 steps, learning from step 500, no evaluation.
-sets=(--set trainer.warmup_episodes=1 --set trainer.episodes=4 --set trainer.config_refit_episodes=0
+# 1 + EPISODES episodes of at most 1000 steps, learning from step 500, no evaluation.
+sets=(--set trainer.warmup_episodes=1 --set trainer.episodes="$episodes" --set trainer.config_refit_episodes=0
       --set trainer.eval_interval=0 --set env.task.max_steps=1000 --set td3.learning_starts=500)
 config=@PROJECT_SOURCE_DIR@/configs/quick.yaml  # configure_file fills in the sources
 
@@ -34,7 +37,7 @@ run() {  # name, then the command's prefix and extra arguments
 }
 declare -A rates
 variants=("threads 1" "ranks 1" "threads 2" "ranks 2")
-echo "load average at the start: $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "load average at the start: $(cut -d' ' -f1-3 /proc/loadavg); 1 + $episodes episodes a training"
 for r in $(seq "$rounds"); do
   rates["threads 1"]+=" $(run t1 "$exe" train)"
   rates["ranks 1"]+=" $(run r1 mpirun --oversubscribe -np 2 "$exe" train)"
