@@ -24,19 +24,24 @@ void check(int code, const char* what) {
 
 // Waits for a message from `source` (MPI_ANY_SOURCE: any rank) with `tag`
 // (MPI_ANY_TAG: any) without spinning on the core (MPI's blocking receive
-// polls it at 100 %): sleeps from 20 us, doubling up to `longest`. The host
-// waits a whole round for rollouts (1 ms: a wake-up a millisecond); an actor
-// waits while the host closes the round, and its wake-up delays the next
-// round (200 us).
-MPI_Status wait_for_message(int source, int tag, std::chrono::microseconds longest) {
+// polls it at 100 %): sleeps from 20 us, doubling up to `longest`, and up to
+// 100 us once `due` has passed. The host waits a whole round for rollouts
+// (1 ms: a wake-up a millisecond) until the time the last round took is
+// nearly up; an actor waits while the host closes the round, and its
+// wake-up delays the next round (200 us).
+MPI_Status wait_for_message(int source, int tag, std::chrono::microseconds longest,
+                            Clock::time_point due = Clock::time_point::max()) {
+  constexpr std::chrono::microseconds kWhenDue(100);
   MPI_Status status;
   int arrived = 0;
   auto nap = std::chrono::microseconds(20);
   while (true) {
     check(MPI_Iprobe(source, tag, MPI_COMM_WORLD, &arrived, &status), "MPI_Iprobe");
     if (arrived) return status;
+    const auto most = Clock::now() < due ? longest : std::min(longest, kWhenDue);
+    nap = std::min(nap, most);
     std::this_thread::sleep_for(nap);
-    nap = std::min(2 * nap, longest);
+    nap = std::min(2 * nap, most);
   }
 }
 
@@ -142,14 +147,19 @@ std::vector<Rollout*>& ActorRanks::round(const ActingWeights& weights, const std
     rollouts_[i] = nullptr;
     expected += orders[i].episode >= 0;
   }
+  // Short naps from 90 % of the last round's time on: a 1 ms nap would
+  // overshoot a rollout's arrival by 0.5 ms on average, 1.5 % of a round.
+  const Clock::time_point released = Clock::now();
+  const Clock::time_point due = released + last_round_ * 9 / 10;
   for (; expected > 0; --expected) {
-    const MPI_Status status = wait_for_message(MPI_ANY_SOURCE, kRollout, std::chrono::microseconds(1000));
+    const MPI_Status status = wait_for_message(MPI_ANY_SOURCE, kRollout, std::chrono::microseconds(1000), due);
     receive(status.MPI_SOURCE, status, bytes_);
     const auto i = static_cast<std::size_t>(status.MPI_SOURCE - 1);
     if (rollouts_[i]) throw std::logic_error("actor rank " + std::to_string(i + 1) + " sent two rollouts in a round");
     rollout_from_bytes(bytes_, received_[i]);
     rollouts_[i] = &received_[i];
   }
+  last_round_ = Clock::now() - released;
   // Done by now (the probes above moved them on): the buffers are free again.
   check(MPI_Waitall(static_cast<int>(sends_.size()), sends_.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
   return rollouts_;

@@ -38,6 +38,7 @@ class ActorRanks final : public ActorTransport {
   std::vector<char> bytes_;
   std::vector<std::vector<char>> releases_;  // by actor: in flight until every send is done
   std::vector<MPI_Request> sends_;
+  Clock::duration last_round_{};  // from the releases to the last rollout
 };
 
 }  // namespace comorph::coopt
