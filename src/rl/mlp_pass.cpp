@@ -83,9 +83,12 @@ void MlpPass::backward(const float* output_grad, bool parameter_grads, bool inpu
 
 const float* MlpRow::forward(const Mlp& net, const float* input) {
   const auto& layers = net->layers();
-  std::size_t widest = static_cast<std::size_t>(layers.front()->weight.size(1));
+  std::size_t widest = 0;  // the widest layer output (the input is read in place)
   for (const auto& layer : layers) widest = std::max(widest, static_cast<std::size_t>(layer->weight.size(0)));
-  if (from_.size() < widest) from_.resize(widest), to_.resize(widest);
+  if (from_.size() < widest) {
+    from_.resize(widest);
+    to_.resize(widest);
+  }
   const float* x = input;
   for (std::size_t i = 0; i < layers.size(); ++i) {
     const int in = static_cast<int>(layers[i]->weight.size(1)), out = static_cast<int>(layers[i]->weight.size(0));
