@@ -13,7 +13,8 @@
 namespace comorph::rl {
 
 struct ActingState {
-  // TD3's coloured exploration noise; empty at an episode's start.
+  // TD3's and SAC's coloured exploration noise (step_unit_noise); empty at
+  // an episode's start.
   std::vector<float> noise;
   // TD3's actor on one vector observation (CPU): the row pass, and the
   // chosen head's outputs [1, action dims] before and after tanh, which

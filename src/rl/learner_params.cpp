@@ -17,6 +17,13 @@ void add_linear_schedule(YamlFields& f, const std::string& prefix, double& start
   f.add(prefix + "_decay", &decay, 0.0, 1e12, unit + " to decay over, linearly; 0 = constant " + prefix + "_end");
 }
 
+// TD3's and SAC's exploration_noise_correlation (rl/off_policy.hpp, step_unit_noise).
+void add_noise_correlation_field(YamlFields& f, double& rho) {
+  f.add("exploration_noise_correlation", &rho, 0.0, 0.9999,
+        "correlation of the exploration noise (and of the random warm-up's actions) between steps: 0 = white, "
+        "> 0 AR(1) forgetting over -1/ln(rho) steps");
+}
+
 // The learner's fields, read from `node`, then the shared checks.
 template <class Config>
 Config read_learner_config(const YAML::Node& node, const std::string& source) {
@@ -54,8 +61,7 @@ void add_fields(YamlFields& f, Td3Config& c) {
                       c.exploration_noise_decay, 10.0, "std of the exploration noise, action units",
                       "transitions or episodes (exploration_noise_unit)");
   f.add("exploration_noise_unit", &c.exploration_noise_unit, "what exploration_noise_decay counts");
-  f.add("exploration_noise_correlation", &c.exploration_noise_correlation, 0.0, 0.9999,
-        "correlation of the exploration noise between steps: 0 = white, > 0 AR(1) forgetting over -1/ln(rho) steps");
+  add_noise_correlation_field(f, c.exploration_noise_correlation);
   f.add("bc_weight", &c.bc_weight, 0.0, 1000.0,
         "weight of behaviour cloning towards the transitions' target actions (TD3+BC); 0 = plain TD3");
   f.add("bc_decay_updates", &c.bc_decay_updates, std::int64_t(0), std::int64_t(1) << 40,
@@ -73,6 +79,7 @@ void add_fields(YamlFields& f, SacConfig& c) {
   f.add("target_network_frequency", &c.target_network_frequency, 1, 1000000,
         "critic updates between soft target updates");
   f.add("alpha", &c.alpha, kMinPositive, 1000.0, "entropy temperature (the initial value when autotuned)");
+  add_noise_correlation_field(f, c.exploration_noise_correlation);
   f.add("autotune_alpha", &c.autotune_alpha, "learn alpha towards the target entropy");
   f.add("target_entropy_scale", &c.target_entropy_scale, -100.0, 100.0,
         "target entropy = -scale * action dimensions, nats");

@@ -190,6 +190,12 @@ struct SacConfig : ActorCriticNetworkConfig {
   double target_entropy_scale = 1.0;     // target entropy = -scale * action_dims (nats)
   double log_std_min = -5.0;             // actor log-std range
   double log_std_max = 2.0;
+  // Correlation rho, between consecutive steps of an episode, of the unit
+  // noise of the exploring policy's samples (the Gaussian's eps) and of the
+  // random-action warm-up's actions: 0 = white; > 0 the AR(1) process of
+  // rl/off_policy.hpp (coloured noise in SAC, as Eberhard et al. 2023).
+  // Only acting; the updates draw their own white samples.
+  double exploration_noise_correlation = 0;
   double max_grad_norm = 0;              // clip gradient L2 norms; 0 = off
 
   static SacConfig from_yaml(const YAML::Node& node, const std::string& source);

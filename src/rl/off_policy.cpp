@@ -41,9 +41,27 @@ torch::Tensor actor_features_of(ActorCritic& nets, const Observation& o, const O
   return nets->actor_features(image_batch(o, spec, device), vector_batch(o, spec, device), {});
 }
 
+void step_unit_noise(double rho, int action_dims, std::mt19937_64& rng, std::vector<float>& z) {
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  if (z.empty()) {
+    z.resize(static_cast<std::size_t>(action_dims));
+    for (float& v : z) v = normal(rng);
+    return;
+  }
+  const auto r = static_cast<float>(rho), innovation = static_cast<float>(std::sqrt(1.0 - rho * rho));
+  for (float& v : z) v = r * v + innovation * normal(rng);
+}
+
 bool random_warmup_action(std::int64_t random_action_steps, std::int64_t random_action_episodes,
-                          const LearnerCounters& n, bool explore, std::mt19937_64& rng, Action& action) {
+                          const LearnerCounters& n, bool explore, double rho, std::mt19937_64& rng,
+                          std::vector<float>& noise, Action& action) {
   if (!explore || !in_random_warmup(random_action_steps, random_action_episodes, n)) return false;
+  if (rho > 0) {
+    step_unit_noise(rho, static_cast<int>(action.continuous.size()), rng, noise);
+    for (std::size_t i = 0; i < action.continuous.size(); ++i)
+      action.continuous[i] = static_cast<float>(std::erf(noise[i] / std::sqrt(2.0)));
+    return true;
+  }
   std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
   for (float& a : action.continuous) a = uniform(rng);
   return true;

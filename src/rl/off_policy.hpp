@@ -33,20 +33,32 @@ inline bool in_random_warmup(std::int64_t random_action_steps, std::int64_t rand
                              const LearnerCounters& counters) {
   return counters.transitions < random_action_steps || counters.episodes < random_action_episodes;
 }
-// While that warm-up lasts and the caller explores, fills `action`
-// uniformly in [-1, 1] and returns true.
-bool random_warmup_action(std::int64_t random_action_steps, std::int64_t random_action_episodes,
-                          const LearnerCounters& counters, bool explore, std::mt19937_64& rng, Action& action);
+// One step of the exploration noise's unit process in `z` (one value per
+// action dimension): with correlation rho > 0 the AR(1) process
+// z' = rho z + sqrt(1 - rho^2) e, e ~ N(0, 1), whose values are N(0, 1) at
+// every step (an empty `z` starts from that distribution) and whose
+// correlation decays over -1 / ln(rho) steps (Ornstein-Uhlenbeck sampled at
+// the control interval). Held for many steps, a correlated draw explores what
+// a sustained action does (a stair gait), which white noise averages away.
+void step_unit_noise(double rho, int action_dims, std::mt19937_64& rng, std::vector<float>& z);
 
-// The acting rule TD3 and SAC share, for the learner and its Policy: a uniform
+// While that warm-up lasts and the caller explores, fills `action` uniformly
+// in [-1, 1] and returns true: white with rho = 0, else erf(z / sqrt 2) of
+// the AR(1) process in `noise` (uniform at every step, correlated between steps).
+bool random_warmup_action(std::int64_t random_action_steps, std::int64_t random_action_episodes,
+                          const LearnerCounters& counters, bool explore, double rho, std::mt19937_64& rng,
+                          std::vector<float>& noise, Action& action);
+
+// The acting rule TD3 and SAC share, for the learner and its Policy: a random
 // action during the random-action warm-up (returns false), else the actor's
 // action_dims values, which `actor_output(out)` writes into action.continuous
 // (returns true).
 template <typename Config, typename ActorOutput>
 bool act_continuous(const Config& c, int action_dims, const LearnerCounters& counters, bool explore,
-                    std::mt19937_64& rng, Action& action, ActorOutput&& actor_output) {
+                    std::mt19937_64& rng, ActingState& state, Action& action, ActorOutput&& actor_output) {
   action.continuous.resize(action_dims);
-  if (random_warmup_action(c.random_action_steps, c.random_action_episodes, counters, explore, rng, action))
+  if (random_warmup_action(c.random_action_steps, c.random_action_episodes, counters, explore,
+                           c.exploration_noise_correlation, rng, state.noise, action))
     return false;
   actor_output(action.continuous.data());
   return true;

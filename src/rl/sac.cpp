@@ -19,14 +19,20 @@ ActorCritic make_networks(const ObservationSpec& spec, int action_dims, const Sa
   return nets;
 }
 
+// The actor's Gaussian from its features: the mean and the log std, bounded
+// to [log_std_min, log_std_max].
+std::pair<torch::Tensor, torch::Tensor> mean_and_log_std(ActorCritic& nets, const SacConfig& c, int action_dims,
+                                                         const torch::Tensor& features) {
+  const torch::Tensor out = nets->actor_head(features);
+  const torch::Tensor log_std = torch::tanh(out.slice(1, action_dims, 2 * action_dims));
+  return {out.slice(1, 0, action_dims), c.log_std_min + 0.5 * (c.log_std_max - c.log_std_min) * (log_std + 1)};
+}
+
 // Squashed Gaussian sample and its log-probability, from actor features.
 std::pair<torch::Tensor, torch::Tensor> sample_action(ActorCritic& nets, const SacConfig& c, int action_dims,
                                                       const torch::Tensor& features, std::mt19937_64& rng,
                                                       const torch::Device& device) {
-  const torch::Tensor out = nets->actor_head(features);
-  const torch::Tensor mean = out.slice(1, 0, action_dims);
-  torch::Tensor log_std = torch::tanh(out.slice(1, action_dims, 2 * action_dims));
-  log_std = c.log_std_min + 0.5 * (c.log_std_max - c.log_std_min) * (log_std + 1);
+  const auto [mean, log_std] = mean_and_log_std(nets, c, action_dims, features);
   const torch::Tensor eps = gaussian_noise(features.size(0), action_dims, 1.0, rng, device);
   const torch::Tensor x = mean + log_std.exp() * eps;  // reparameterised
   const torch::Tensor y = torch::tanh(x);
@@ -36,15 +42,23 @@ std::pair<torch::Tensor, torch::Tensor> sample_action(ActorCritic& nets, const S
   return {y, log_prob};
 }
 
-// The acting rule of the learner and of its Policy: uniform actions during the
+// The acting rule of the learner and of its Policy: random actions during the
 // random-action warm-up, else a sample of the squashed Gaussian (exploring) or its mean.
+// With exploration_noise_correlation rho > 0 the sample's unit noise, like the
+// warm-up's actions, follows the AR(1) process of step_unit_noise.
 void act_with(ActorCritic& nets, const ObservationSpec& spec, int action_dims, const SacConfig& c,
-              const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng,
-              ActingState& /*state: unused*/, const Observation& o, bool explore, Action& action) {
-  act_continuous(c, action_dims, n, explore, rng, action, [&](float* out) {
+              const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng, ActingState& state,
+              const Observation& o, bool explore, Action& action) {
+  act_continuous(c, action_dims, n, explore, rng, state, action, [&](float* out) {
     copy_tensor_action(
         [&] {
           const torch::Tensor f = actor_features_of(nets, o, spec, device);
+          if (explore && c.exploration_noise_correlation > 0) {
+            step_unit_noise(c.exploration_noise_correlation, action_dims, rng, state.noise);
+            const auto [mean, log_std] = mean_and_log_std(nets, c, action_dims, f);
+            const torch::Tensor eps = torch::from_blob(state.noise.data(), {1, action_dims}).to(f.device());
+            return torch::tanh(mean + log_std.exp() * eps);
+          }
           if (explore) return sample_action(nets, c, action_dims, f, rng, device).first;
           return torch::tanh(nets->actor_head(f).slice(1, 0, action_dims));  // the mean action
         },

@@ -37,24 +37,6 @@ torch::Tensor chosen_heads(const torch::Tensor& outputs, const ObservationSpec& 
       .squeeze(1);
 }
 
-// One step of the exploration noise's unit process in `z` (one value per
-// action dimension): white, or with correlation rho > 0 the AR(1) process
-// z' = rho z + sqrt(1 - rho^2) e, e ~ N(0, 1), whose values are N(0, 1) at
-// every step (an empty `z` starts from that distribution) and whose
-// correlation decays over -1 / ln(rho) steps (Ornstein-Uhlenbeck sampled at
-// the control interval). Held for many steps, a correlated draw explores what
-// a sustained action does (a stair gait), which white noise averages away.
-void step_unit_noise(double rho, int action_dims, std::mt19937_64& rng, std::vector<float>& z) {
-  std::normal_distribution<float> normal(0.0f, 1.0f);
-  if (z.empty()) {
-    z.resize(static_cast<std::size_t>(action_dims));
-    for (float& v : z) v = normal(rng);
-    return;
-  }
-  const auto r = static_cast<float>(rho), innovation = static_cast<float>(std::sqrt(1.0 - rho * rho));
-  for (float& v : z) v = r * v + innovation * normal(rng);
-}
-
 // tanh of the actor's output (its chosen head's) for one vector observation
 // on the CPU: the row pass, then LibTorch's tanh on preallocated tensors; the
 // same bits as the tensor path, without its dispatch.
@@ -76,20 +58,13 @@ void squashed_actor_row(ActorCritic& nets, const ObservationSpec& spec, int acti
 // The acting rule of the learner and of its Policy: random actions during the
 // random-action warm-up, else tanh(actor) plus clipped noise when exploring.
 // With exploration_noise_correlation 0 both are white (uniform actions,
-// Gaussian noise); with rho > 0 both follow the AR(1) process above (the
+// Gaussian noise); with rho > 0 both follow step_unit_noise's AR(1) process (the
 // warm-up's action erf(z / sqrt 2) is uniform in [-1, 1] at every step).
 void act_with(ActorCritic& nets, const ObservationSpec& spec, int action_dims, const Td3Config& c,
               const torch::Device& device, const LearnerCounters& n, std::mt19937_64& rng, ActingState& state,
               const Observation& o, bool explore, Action& action) {
   const double rho = c.exploration_noise_correlation;
-  if (explore && rho > 0 && in_random_warmup(c.random_action_steps, c.random_action_episodes, n)) {
-    action.continuous.resize(static_cast<std::size_t>(action_dims));
-    step_unit_noise(rho, action_dims, rng, state.noise);
-    for (int i = 0; i < action_dims; ++i)
-      action.continuous[i] = static_cast<float>(std::erf(state.noise[i] / std::sqrt(2.0)));
-    return;
-  }
-  const bool from_actor = act_continuous(c, action_dims, n, explore, rng, action, [&](float* out) {
+  const bool from_actor = act_continuous(c, action_dims, n, explore, rng, state, action, [&](float* out) {
     if (!spec.has_image() && device.is_cpu() && MlpPass::supports(nets->actor))
       return squashed_actor_row(nets, spec, action_dims, o, state, out);
     copy_tensor_action(

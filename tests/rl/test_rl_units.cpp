@@ -4,6 +4,7 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <type_traits>
 #include <unistd.h>
 
 #include <algorithm>
@@ -484,14 +485,16 @@ TEST(Td3, ExplorationNoiseDecaysPerEpisode) {
 }
 
 // Exploration noise of one policy over an episode of `steps` steps on a fixed
-// observation: the action minus the greedy action, per step, dimension 0.
+// observation: the action minus the greedy action, per step, dimension 0
+// (the action itself during the random warm-up).
+template <class Algorithm, class Config>
 std::vector<double> exploration_deviations(double correlation, int steps, bool warmup) {
-  rl::Td3Config c;
+  Config c;
   c.hidden_sizes = {8};
   c.random_action_steps = warmup ? 1000000 : 0;
-  c.exploration_noise_start = c.exploration_noise_end = 0.2;
+  if constexpr (std::is_same_v<Config, rl::Td3Config>) c.exploration_noise_start = c.exploration_noise_end = 0.2;
   c.exploration_noise_correlation = correlation;
-  const auto policy = rl::Td3::policy({0, 0, 0, 1}, 2, c, 7);
+  const auto policy = Algorithm::policy({0, 0, 0, 1}, 2, c, 7);
   rl::Action greedy, a;
   policy->act(vector_obs({0.3f}), false, greedy);
   std::vector<double> d;
@@ -522,13 +525,27 @@ std::pair<double, double> lag1_and_std(const std::vector<double>& x) {
 TEST(Td3, CorrelatedExplorationNoiseKeepsItsStdAndHasTheAskedCorrelation) {
   for (double rho : {0.0, 0.9, 0.98}) {
     // One episode of 20 000 steps.
-    const auto [lag1, std] = lag1_and_std(exploration_deviations(rho, 20000, false));
+    const auto [lag1, std] = lag1_and_std(exploration_deviations<rl::Td3, rl::Td3Config>(rho, 20000, false));
     EXPECT_NEAR(lag1, rho, 0.02) << "rho " << rho;
     EXPECT_NEAR(std, 0.2, rho > 0.95 ? 0.03 : 0.01) << "rho " << rho;
-    const auto [warm_lag1, warm_std] = lag1_and_std(exploration_deviations(rho, 20000, true));
+    const auto [warm_lag1, warm_std] = lag1_and_std(exploration_deviations<rl::Td3, rl::Td3Config>(rho, 20000, true));
     EXPECT_NEAR(warm_std, 1.0 / std::sqrt(3.0), rho > 0.95 ? 0.05 : 0.02) << "rho " << rho;
     EXPECT_GT(warm_lag1, rho - 0.05) << "rho " << rho;
     EXPECT_LT(warm_lag1, rho + 0.05) << "rho " << rho;
+  }
+}
+
+// SAC's exploring samples draw their unit noise from the same process: white
+// (lag-1 correlation 0) by default, correlated as asked with rho; its random
+// warm-up is TD3's (uniform in [-1, 1], correlated with rho).
+TEST(Sac, CorrelatedExplorationHasTheAskedCorrelation) {
+  for (double rho : {0.0, 0.9, 0.98}) {
+    const auto [lag1, std] = lag1_and_std(exploration_deviations<rl::Sac, rl::SacConfig>(rho, 10000, false));
+    EXPECT_NEAR(lag1, rho, rho > 0 ? 0.02 : 0.03) << "rho " << rho;
+    EXPECT_GT(std, 0.05) << "rho " << rho;  // the initial actor's std, about exp(-1.5)
+    const auto [warm_lag1, warm_std] = lag1_and_std(exploration_deviations<rl::Sac, rl::SacConfig>(rho, 10000, true));
+    EXPECT_NEAR(warm_std, 1.0 / std::sqrt(3.0), rho > 0.95 ? 0.06 : 0.02) << "rho " << rho;
+    EXPECT_NEAR(warm_lag1, rho, 0.05) << "rho " << rho;
   }
 }
 
