@@ -172,7 +172,9 @@ TEST(Checkpoint, AChangedSimulatorConfigIsRefusedOnResume) {
   EXPECT_NE(e.find("wheel_radius: 0.07"), std::string::npos) << e;
   EXPECT_NE(e.find("refusing to resume"), std::string::npos) << e;
   // Evaluating it under other physics is refused too.
-  EXPECT_NE(error_of([&] { evaluate(edited, dir, EvalRequest{"default", 1, 1, 1}); }).find("changed"),
+  EvalRequest one;
+  one.episodes = one.seed = one.workers = 1;
+  EXPECT_NE(error_of([&] { evaluate(edited, dir, one); }).find("changed"),
             std::string::npos);
   fs::remove_all(dir);
   fs::remove_all(env);

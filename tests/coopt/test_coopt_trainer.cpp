@@ -191,7 +191,11 @@ TEST(Trainer, ConfigModelLearnsFromEpisodeReturns) {
   EXPECT_FALSE(r.decisions.empty());
   EXPECT_TRUE(r.decisions.back().terminated || r.decisions.back().truncated);
   const CooptConfig c = load_coopt_config(kCi, {"trainer.config_target=return"});
-  EXPECT_EQ(evaluate(c, dir, {"default", 3, 4242, 1}).size(), 3u);
+  EvalRequest three;
+  three.episodes = 3;
+  three.seed = 4242;
+  three.workers = 1;
+  EXPECT_EQ(evaluate(c, dir, three).size(), 3u);
   fs::remove_all(dir);
   try {
     load_coopt_config(kCi, {"trainer.config_target=td"});
@@ -254,7 +258,11 @@ TEST(Trainer, ConfigRefitTrainsAFreshDqnOnTheFrozenMotionModel) {
   EXPECT_EQ(refit_decisions, (std::vector<int>{6, 7, 8}));
   const auto greedy_lines = [](CooptConfig c, const std::string& dir) {
     std::vector<std::string> lines;
-    for (const EpisodeLog& l : evaluate(c, dir, {"default", 6, 4242, 1})) lines.push_back(line_of(l));
+    EvalRequest six;
+    six.episodes = 6;
+    six.seed = 4242;
+    six.workers = 1;
+    for (const EpisodeLog& l : evaluate(c, dir, six)) lines.push_back(line_of(l));
     return lines;
   };
   CooptConfig plain_config = load_coopt_config(kCi, kWithDemonstrations);
