@@ -53,14 +53,13 @@ void act_with(ActorCritic& nets, const ObservationSpec& spec, int action_dims, c
     copy_tensor_action(
         [&] {
           const torch::Tensor f = actor_features_of(nets, o, spec, device);
-          if (explore && c.exploration_noise_correlation > 0) {
-            step_unit_noise(c.exploration_noise_correlation, action_dims, rng, state.noise);
-            const auto [mean, log_std] = mean_and_log_std(nets, c, action_dims, f);
-            const torch::Tensor eps = torch::from_blob(state.noise.data(), {1, action_dims}).to(f.device());
-            return torch::tanh(mean + log_std.exp() * eps);
-          }
-          if (explore) return sample_action(nets, c, action_dims, f, rng, device).first;
-          return torch::tanh(nets->actor_head(f).slice(1, 0, action_dims));  // the mean action
+          if (!explore) return torch::tanh(nets->actor_head(f).slice(1, 0, action_dims));  // the mean action
+          const double rho = c.exploration_noise_correlation;
+          if (rho > 0) step_unit_noise(rho, action_dims, rng, state.noise);
+          const torch::Tensor eps = rho > 0 ? torch::from_blob(state.noise.data(), {1, action_dims}).to(device)
+                                            : gaussian_noise(1, action_dims, 1.0, rng, device);
+          const auto [mean, log_std] = mean_and_log_std(nets, c, action_dims, f);
+          return torch::tanh(mean + log_std.exp() * eps);
         },
         out);
   });
