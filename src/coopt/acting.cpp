@@ -157,6 +157,7 @@ void Actor::take(const ActingWeights& weights, const Orders& orders) {
     if (orders.set_config_rng) agent_.config->set_rng(orders.config_rng);
   }
   if (orders.start) {
+    stair_height_m_ = orders.stair_height_m;
     rng_ = orders.rng;
     agent_.motion->set_rng(orders.motion_rng);
   }
@@ -205,7 +206,8 @@ void Actor::serve(ActorLink& link) {
 // One training episode; its end is the round's end (rollout_.ended).
 void Actor::play(int episode, ActorLink& link) {
   const TrainerParams& t = config_.trainer;
-  const EpisodePlan plan = plan_episode(t, episode);
+  EpisodePlan plan = plan_episode(t, episode);
+  if (stair_height_m_ > 0) plan.spec.stair_height = stair_height_m_;
   LearnHooks hooks;
   hooks.laps = &laps;
   hooks.motion = [this, &link, learning = !plan.refit](const rl::Observation& o, const rl::Action& a, float r,
@@ -381,7 +383,7 @@ template <class F, class W, class O>
 void release_fields(F& f, W& w, O& o) {
   f(w.motion_version), f(w.config_version), f(w.config_refit), f(w.config_counters);
   f(o.episode), f(o.start), f(o.rng), f(o.motion_rng), f(o.set_motion_counters), f(o.motion_counters);
-  f(o.set_config_rng), f(o.config_rng);
+  f(o.set_config_rng), f(o.config_rng), f(o.stair_height_m);
 }
 
 }  // namespace

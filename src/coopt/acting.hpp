@@ -63,7 +63,8 @@ struct EpisodePlan {
 EpisodePlan plan_episode(const TrainerParams& t, int episode);
 
 // The seed of random stream `stream` of training episode `episode` (several
-// actors: 0 the actor's RNG, 1 the motion policy's, 2 the DQN copy's).
+// actors: 0 the actor's RNG, 1 the motion policy's, 2 the DQN copy's; any
+// actor count: 3 the stair curriculum's height).
 std::uint64_t stream_seed(int seed, int episode, int stream);
 // The first episode index after `from` before which every actor must have
 // ended its episode: a checkpoint, an evaluation, the refit's start, the end.
@@ -137,6 +138,7 @@ struct Orders {
   rl::LearnerCounters motion_counters;
   bool set_config_rng = false;  // the DQN copy's RNG
   std::mt19937_64 config_rng;
+  double stair_height_m = 0;  // with `start`: > 0 the episode's stair height (trainer.stair_curriculum)
 };
 
 // The values as bytes, for a transport between processes (coopt/actor_ranks.hpp).
@@ -206,6 +208,7 @@ class Actor {
   std::uint64_t motion_version_ = 0, config_version_ = 0;
   task::ScriptedPilot pilot_;
   std::mt19937_64 rng_;  // the episode's uniform configuration choices and pilot noise
+  double stair_height_m_ = 0;  // > 0: the host's stair height for the episode
   Rollout rollout_;
   int interval_ = 0;    // one actor: motion transitions since the learner's last hand-over
   int round_cost_ = 0;  // lockstep: the round's simulation work so far

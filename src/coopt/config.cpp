@@ -105,6 +105,11 @@ void add_fields(YamlFields& f, TrainerParams& p) {
   f.add("random_config_interval", &p.random_config_interval, 0, kMaxEpisodes,
         "after the warm-up, every this-many-th model-driven episode draws its chains uniformly instead of asking "
         "the DQN (no pilot needed); 0 = none");
+  f.add("stair_curriculum", &p.stair_curriculum, 0.0, 1.0,
+        "share of the training episodes after the warm-up whose stair height is drawn in proportion to the run's "
+        "recent failure rate at each height (the rest uniformly); 0 = none");
+  f.add("stair_curriculum_window", &p.stair_curriculum_window, 1, kMaxEpisodes,
+        "the last this-many training episodes at each height give its failure rate (stair_curriculum)");
   f.add("pilot_gait_per_modules", &p.pilot_gait_per_modules,
         "the pilot climbs with each chain length's searched gait (else one gait for all)");
   f.add("pilot_flat_steering", &p.pilot_flat_steering,
@@ -184,6 +189,9 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
          std::to_string(p.refit_sweep_scenes) + " scenes x " + std::to_string(kCandidates) +
              " chain lengths is more than trainer.config_refit_episodes (" + std::to_string(p.config_refit_episodes) +
              ")");
+  if (p.stair_curriculum > 0 && p.stair_height > 0)
+    fail(source, pre + ".stair_curriculum",
+         "needs the stair heights drawn per episode (trainer.stair_height 0), not one height always");
   if (p.config_refit_episodes > 0 && p.mode != TrainerMode::hierarchical)
     fail(source, pre + ".config_refit_episodes", "needs trainer.mode hierarchical (a fixed chain has no DQN)");
   // Whether the directory holds a classifier is checked where it is loaded

@@ -114,6 +114,13 @@ struct TrainerParams {
   // uniformly too (0 = none): the motion model keeps practising every chain
   // length without a pilot, instead of only the one the DQN settles on.
   int random_config_interval = 0;
+  // A share of the training episodes after the warm-up (0 = none) takes its
+  // stair height in proportion to the run's recent failure rate at each
+  // height, over its last stair_curriculum_window training episodes there
+  // (coopt/stair_curriculum.hpp); the rest keep the scene's uniform draw.
+  // More practice where the run fails, from its own outcomes only.
+  double stair_curriculum = 0;
+  int stair_curriculum_window = 50;
   // The refit's first refit_sweep_scenes x 9 episodes play each of that many
   // scenes once per chain length, the first configuration forced in turn (the
   // later ones the DQN's). Every (stair height, chain) pair then gets samples

@@ -97,6 +97,9 @@ Orders LearnerHost::start_orders(int episode) const {
     o.config_rng.seed(stream_seed(seed, episode, 2));
     o.motion_counters = {state_.steps, episode, 0};
   }
+  const TrainerParams& t = config_.trainer;
+  if (t.stair_curriculum > 0 && episode >= t.warmup_episodes && episode < t.refit_start())
+    o.stair_height_m = state_.curriculum.draw(height_weights_, stream_seed(t.seed, episode, 3));
   return o;
 }
 
@@ -110,6 +113,8 @@ void LearnerHost::begin_block() {
   }
   end_ = one_actor_ ? state_.episode + 1 : block_end(t, state_.episode);
   next_ = state_.episode;
+  // Fixed for the block: every actor count draws from the same probabilities.
+  if (t.stair_curriculum > 0) height_weights_ = state_.curriculum.weights(t.stair_curriculum);
   refresh_motion();
   refresh_config();
   active_ = 0;
@@ -309,6 +314,8 @@ void LearnerHost::take_motion_model(const std::string& run_dir) {
 }
 
 void LearnerHost::log_episode(const EpisodeLog& log) {
+  const TrainerParams& t = config_.trainer;
+  if (!log.warmup && log.episode < t.refit_start()) state_.curriculum.record(log.stair_height_m, log.success);
   store_.append_episode(log);
   if (callbacks_.on_episode) callbacks_.on_episode(log);
   progress(log);
@@ -334,13 +341,24 @@ void LearnerHost::progress(const EpisodeLog& log) {
                                                     : 0;
   const double eta_s = episode_s * (total - episode);
   const std::string configs = task::configuration_sequence(log.configurations);
+  std::string curriculum;  // the next training episodes' stair-height probabilities
+  if (t.stair_curriculum > 0 && episode >= t.warmup_episodes && episode < t.refit_start()) {
+    curriculum = " | heights drawn";
+    const std::vector<double> weights = state_.curriculum.weights(t.stair_curriculum);
+    for (std::size_t i = 0; i < weights.size(); ++i) {
+      char part[16];
+      std::snprintf(part, sizeof part, "%s%.0f", i > 0 ? "/" : " ", 100.0 * weights[i]);
+      curriculum += part;
+    }
+    curriculum += " %";
+  }
   std::fprintf(stderr,
                "episode %d/%d%s%s | %d steps, return %.1f, %s | total %lld steps, %.0f steps/s | success %.0f %% "
-               "(last %zu) | config %s (stairs %.2f m) | wall %.0f s, ETA %.0f s\n",
+               "(last %zu) | config %s (stairs %.2f m)%s | wall %.0f s, ETA %.0f s\n",
                episode, total, log.warmup ? " (warm-up)" : "", episode > t.refit_start() ? " (DQN refit)" : "",
                log.steps, log.return_R1, log.termination.c_str(), static_cast<long long>(state_.steps),
                w > 0 ? state_.steps / w : 0.0, 100.0 * rate, recent_success_.size(), configs.c_str(),
-               log.stair_height_m, w, eta_s);
+               log.stair_height_m, curriculum.c_str(), w, eta_s);
 }
 
 TrainerTiming LearnerHost::timing(const std::array<Clock::duration, kPhases>& actor_time, int actors) const {

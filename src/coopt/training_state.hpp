@@ -11,6 +11,7 @@
 
 #include "coopt/config.hpp"
 #include "coopt/episode_runner.hpp"
+#include "coopt/stair_curriculum.hpp"
 #include "rl/replay_segments.hpp"
 
 namespace comorph::coopt {
@@ -38,6 +39,7 @@ struct TrainingState {
   int evaluations = 0;                  // periodic evaluations done (= rows of evaluations.csv)
   std::int64_t steps = 0;               // training control steps
   double wall_before = 0;               // training wall time of the earlier sessions (resume), s
+  StairCurriculum curriculum;           // the training episodes' recent outcomes per stair height
   // The replay segments of the last checkpoint written or loaded: the next
   // checkpoint links those and writes only what was added since.
   rl::ReplaySegments motion_segments, config_segments;

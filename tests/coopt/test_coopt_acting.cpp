@@ -142,6 +142,7 @@ TEST(ActingBytes, AReleaseSendsWeightsOnlyForANewVersion) {
   o.motion_counters = {100, 12, 0};
   o.set_config_rng = true;
   o.config_rng.discard(3);
+  o.stair_height_m = 0.08;
 
   std::vector<char> bytes;
   release_to_bytes(w, o, true, true, bytes);
@@ -162,6 +163,7 @@ TEST(ActingBytes, AReleaseSendsWeightsOnlyForANewVersion) {
   EXPECT_EQ(ob.motion_counters.transitions, 100);
   EXPECT_TRUE(ob.set_config_rng);
   EXPECT_EQ(ob.config_rng, o.config_rng);
+  EXPECT_EQ(ob.stair_height_m, 0.08);
 
   // An actor holding both versions gets empty buffers and the versions.
   std::vector<char> light;

@@ -13,9 +13,13 @@
 #include <string>
 #include <vector>
 
+#include <yaml-cpp/yaml.h>
+
+#include "coopt/acting.hpp"
 #include "coopt/config.hpp"
 #include "coopt/episode_runner.hpp"
 #include "coopt/segment.hpp"
+#include "coopt/stair_curriculum.hpp"
 #include "coopt/trainer.hpp"
 #include "perception/params.hpp"
 #include "perception/scene_classifier.hpp"
@@ -365,6 +369,69 @@ TEST(Trainer, ResumeAfterInterruptionContinuesTheSameEpisodesWithIdenticalResult
   EXPECT_EQ(csv_rows(dir), csv_rows(full_dir));
   fs::remove_all(full_dir);
   fs::remove_all(dir);
+}
+
+// trainer.stair_curriculum: each training episode after the warm-up takes
+// the height its own stream draws from the run's failure rates so far; the
+// warm-up and the refit keep the scene's draw; the outcomes the draws read
+// go into the checkpoint, so an interrupted run resumes to the same episodes,
+// and several simulation threads repeat their results.
+TEST(Trainer, StairCurriculumDrawsTrainingHeightsFromTheRunsOutcomesAndResumesToThem) {
+  const std::vector<std::string> base{"trainer.episodes=6", "trainer.checkpoint_interval=3",
+                                      "trainer.config_refit_episodes=2"};
+  std::vector<std::string> sets = base;
+  sets.push_back("trainer.stair_curriculum=1");
+  const std::string plain_dir = temp_dir("curriculum_plain"), full_dir = temp_dir("curriculum_full");
+  const RunResult plain = run_ci(base, plain_dir);
+  const RunResult full = run_ci(sets, full_dir);
+  const CooptConfig c = load_coopt_config(kCi, sets);
+  const TrainerParams& t = c.trainer;
+  ASSERT_EQ(full.logs.size(), 10u);
+  StairCurriculum replay(stair_heights(c), t.stair_curriculum_window);  // one actor: the weights after every episode
+  int moved = 0;
+  for (int e = 0; e < 10; ++e) {
+    const EpisodeLog& l = full.logs[static_cast<std::size_t>(e)];
+    const double scene_height = plain.logs[static_cast<std::size_t>(e)].stair_height_m;
+    if (e < t.warmup_episodes || e >= t.refit_start()) {
+      EXPECT_EQ(l.stair_height_m, scene_height) << "episode " << e;
+      continue;
+    }
+    EXPECT_EQ(l.stair_height_m, replay.draw(replay.weights(1.0), stream_seed(t.seed, e, 3))) << "episode " << e;
+    moved += l.stair_height_m != scene_height;
+    replay.record(l.stair_height_m, l.success);
+  }
+  EXPECT_GT(moved, 0) << "the curriculum's draws are the scene's own";
+  const YAML::Node checkpoint = YAML::LoadFile(full_dir + "/checkpoint/trainer.yaml");
+  EXPECT_EQ(checkpoint["stair_curriculum"].as<std::string>(), replay.outcomes_text());
+
+  // Interrupted after episode index 4 and resumed: the same episodes.
+  const std::string dir = temp_dir("curriculum_resume");
+  RunResult part;
+  run_until_stopped(c, dir, 4, part);
+  RunResult rest;
+  {
+    Trainer trainer(c, dir, collecting(rest));
+    trainer.resume();
+    EXPECT_TRUE(trainer.run());
+  }
+  ASSERT_EQ(rest.episodes.size(), 5u);
+  for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(rest.episodes[i], full.episodes[i + 5]) << i;
+
+  // Two simulation threads: the weights are the block's, the same with or without the learner thread.
+  sets.push_back("trainer.simulation_threads=2");
+  auto with = [&sets](const std::string& more) {
+    std::vector<std::string> s = sets;
+    s.push_back(more);
+    return s;
+  };
+  const std::string threads_a = temp_dir("curriculum_threads_a"), threads_b = temp_dir("curriculum_threads_b");
+  const RunResult a = run_ci(with("trainer.learner_thread=true"), threads_a);
+  const RunResult b = run_ci(with("trainer.learner_thread=false"), threads_b);
+  EXPECT_EQ(a.episodes, b.episodes);
+
+  EXPECT_THROW(load_coopt_config(kCi, {"trainer.stair_curriculum=0.5", "trainer.stair_height=0.06"}),
+               std::runtime_error);
+  for (const std::string& d : {plain_dir, full_dir, dir, threads_a, threads_b}) fs::remove_all(d);
 }
 
 // trainer.simulation_threads: the threads step in rounds whose hand-over

@@ -13,6 +13,7 @@
 #include "coopt/config.hpp"
 #include "coopt/config_reference.hpp"
 #include "coopt/segment.hpp"
+#include "coopt/stair_curriculum.hpp"
 #include "coopt/training_state.hpp"
 #include "report/run_dir.hpp"
 #include "support/test_support.hpp"
@@ -91,6 +92,50 @@ TEST(EpisodePlan, RefitSweepPlaysEachSceneOncePerChainLength) {
   t.refit_sweep_scenes = 0;
   for (int e = 0; e < t.total_episodes(); ++e) EXPECT_EQ(plan_episode(t, e).first_config, -1);
   EXPECT_NE(plan_episode(t, start + 1).spec.seed, plan_episode(t, start).spec.seed);
+}
+
+// trainer.stair_curriculum's draw: uniform until the run fails somewhere,
+// then a share in proportion to each height's failure rate over its window.
+TEST(StairCurriculum, DrawsHeightsInProportionToTheirRecentFailures) {
+  StairCurriculum c({0.04, 0.06, 0.08}, 4);
+  for (const double w : c.weights(1.0)) EXPECT_NEAR(w, 1.0 / 3, 1e-12);  // no outcome yet: every height fails
+  for (int i = 0; i < 4; ++i) {
+    c.record(0.04, true);
+    c.record(0.0600000001, true);  // the nearest of the run's heights
+    c.record(0.08, i % 2 == 0);
+  }
+  EXPECT_EQ(c.failure_rates(), (std::vector<double>{0.0, 0.0, 0.5}));
+  EXPECT_EQ(c.weights(1.0), (std::vector<double>{0.0, 0.0, 1.0}));
+  const std::vector<double> half = c.weights(0.5);
+  EXPECT_NEAR(half[0], 1.0 / 6, 1e-12);
+  EXPECT_NEAR(half[2], 2.0 / 3, 1e-12);
+  for (const double w : c.weights(0.0)) EXPECT_NEAR(w, 1.0 / 3, 1e-12);
+  // The window forgets: four later successes at 0.08 m leave no failure anywhere (uniform again).
+  for (int i = 0; i < 4; ++i) c.record(0.08, true);
+  for (const double w : c.weights(1.0)) EXPECT_NEAR(w, 1.0 / 3, 1e-12);
+  c.record(0.06, false);
+  EXPECT_EQ(c.height_at(c.weights(1.0), 0.0), 0.06);
+  EXPECT_EQ(c.height_at(c.weights(1.0), 0.999), 0.06);
+
+  // Draws from independent streams follow the weights; one stream always draws the same.
+  const std::vector<double> w{0.1, 0.3, 0.6};
+  int count[3] = {0, 0, 0};
+  const int n = 6000;
+  for (int e = 0; e < n; ++e) {
+    const double h = c.draw(w, stream_seed(1, e, 3));
+    EXPECT_EQ(h, c.draw(w, stream_seed(1, e, 3)));
+    count[h < 0.05 ? 0 : h < 0.07 ? 1 : 2] += 1;
+  }
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(count[i] / static_cast<double>(n), w[static_cast<std::size_t>(i)], 0.025) << i;
+
+  // The checkpoint's text reads back; a malformed one is refused.
+  StairCurriculum back({0.04, 0.06, 0.08}, 4);
+  back.set_outcomes_text(c.outcomes_text());
+  EXPECT_EQ(back.failure_rates(), c.failure_rates());
+  EXPECT_EQ(back.outcomes_text(), "1111,1110,1111");
+  EXPECT_THROW(back.set_outcomes_text("11,11"), std::runtime_error);
+  EXPECT_THROW(back.set_outcomes_text("11,1x,1"), std::runtime_error);
+  EXPECT_THROW(back.set_outcomes_text("11111,1,1"), std::runtime_error);
 }
 
 TEST(Segment, DecisionReturnsSumTheLaterSegmentsDiscountedOncePerDecision) {
