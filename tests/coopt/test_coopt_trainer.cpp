@@ -93,6 +93,12 @@ void resume_until_killed(const CooptConfig& c, const std::string& dir, int done,
   EXPECT_THROW(t.run(), std::runtime_error);
 }
 
+// `sets` and one more.
+std::vector<std::string> with(std::vector<std::string> sets, const std::string& more) {
+  sets.push_back(more);
+  return sets;
+}
+
 RunResult run_ci(const std::vector<std::string>& sets, const std::string& dir) {
   RunResult r;
   Trainer t(load_coopt_config(kCi, sets), dir, collecting(r));
@@ -379,8 +385,7 @@ TEST(Trainer, ResumeAfterInterruptionContinuesTheSameEpisodesWithIdenticalResult
 TEST(Trainer, StairCurriculumDrawsTrainingHeightsFromTheRunsOutcomesAndResumesToThem) {
   const std::vector<std::string> base{"trainer.episodes=6", "trainer.checkpoint_interval=3",
                                       "trainer.config_refit_episodes=2"};
-  std::vector<std::string> sets = base;
-  sets.push_back("trainer.stair_curriculum=1");
+  std::vector<std::string> sets = with(base, "trainer.stair_curriculum=1");
   const std::string plain_dir = temp_dir("curriculum_plain"), full_dir = temp_dir("curriculum_full");
   const RunResult plain = run_ci(base, plain_dir);
   const RunResult full = run_ci(sets, full_dir);
@@ -419,14 +424,9 @@ TEST(Trainer, StairCurriculumDrawsTrainingHeightsFromTheRunsOutcomesAndResumesTo
 
   // Two simulation threads: the weights are the block's, the same with or without the learner thread.
   sets.push_back("trainer.simulation_threads=2");
-  auto with = [&sets](const std::string& more) {
-    std::vector<std::string> s = sets;
-    s.push_back(more);
-    return s;
-  };
   const std::string threads_a = temp_dir("curriculum_threads_a"), threads_b = temp_dir("curriculum_threads_b");
-  const RunResult a = run_ci(with("trainer.learner_thread=true"), threads_a);
-  const RunResult b = run_ci(with("trainer.learner_thread=false"), threads_b);
+  const RunResult a = run_ci(with(sets, "trainer.learner_thread=true"), threads_a);
+  const RunResult b = run_ci(with(sets, "trainer.learner_thread=false"), threads_b);
   EXPECT_EQ(a.episodes, b.episodes);
 
   EXPECT_THROW(load_coopt_config(kCi, {"trainer.stair_curriculum=0.5", "trainer.stair_height=0.06"}),
@@ -444,14 +444,9 @@ TEST(Trainer, StairCurriculumDrawsTrainingHeightsFromTheRunsOutcomesAndResumesTo
 TEST(Trainer, SimulationThreadsRepeatTheirResultsAndResumeToThem) {
   const std::vector<std::string> sets{"trainer.episodes=6", "trainer.checkpoint_interval=3",
                                       "trainer.simulation_threads=2"};
-  auto with = [&sets](const std::string& more) {
-    std::vector<std::string> s = sets;
-    s.push_back(more);
-    return s;
-  };
   const std::string full_dir = temp_dir("sim_threads_full"), again_dir = temp_dir("sim_threads_again");
-  const RunResult full = run_ci(with("trainer.learner_thread=true"), full_dir);
-  const RunResult again = run_ci(with("trainer.learner_thread=false"), again_dir);
+  const RunResult full = run_ci(with(sets, "trainer.learner_thread=true"), full_dir);
+  const RunResult again = run_ci(with(sets, "trainer.learner_thread=false"), again_dir);
   ASSERT_EQ(full.logs.size(), 8u);
   for (int i = 0; i < 8; ++i) EXPECT_EQ(full.logs[static_cast<std::size_t>(i)].episode, i);
   EXPECT_EQ(full.episodes, again.episodes);
@@ -469,7 +464,7 @@ TEST(Trainer, SimulationThreadsRepeatTheirResultsAndResumeToThem) {
   EXPECT_NE(full.logs[0].seed, full.logs[1].seed);
 
   // Ctrl-C after episode index 3 is written: the block [3, 6) is finished first.
-  const CooptConfig c = load_coopt_config(kCi, with("trainer.learner_thread=true"));
+  const CooptConfig c = load_coopt_config(kCi, with(sets, "trainer.learner_thread=true"));
   const std::string dir = temp_dir("sim_threads_resume");
   RunResult part;
   run_until_stopped(c, dir, 3, part, 6);
