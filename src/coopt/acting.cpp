@@ -227,6 +227,11 @@ void Actor::play(int episode, ActorLink& link) {
     if (round_cost_ >= round_quota(config_.trainer) && !done) hand_over(link);
   };
   hooks.motion_greedy = plan.greedy_motion;
+  if (!plan.refit && t.config_energy_weight >= 0) {
+    training_r2_ = config_.env.task.r2;
+    training_r2_.sigma3 = t.config_energy_weight;
+    hooks.config_r2 = &training_r2_;
+  }
   const double config_gamma = config_model_params(config_, plan.refit).gamma;  // the refit's own in the refit
   hooks.config = [this, &link, episode, learns = plan.config_learns, config_gamma](
                      const rl::Observation& o, const rl::Action& a, float r2, const rl::Observation& n, bool term,

@@ -209,6 +209,7 @@ class Actor {
   task::ScriptedPilot pilot_;
   std::mt19937_64 rng_;  // the episode's uniform configuration choices and pilot noise
   double stair_height_m_ = 0;  // > 0: the host's stair height for the episode
+  task::R2Params training_r2_;  // the R2 the DQN learns from before the refit (trainer.config_energy_weight)
   Rollout rollout_;
   int interval_ = 0;    // one actor: motion transitions since the learner's last hand-over
   int round_cost_ = 0;  // lockstep: the round's simulation work so far

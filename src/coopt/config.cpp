@@ -110,6 +110,9 @@ void add_fields(YamlFields& f, TrainerParams& p) {
         "recent failure rate at each height (the rest uniformly); 0 = none");
   f.add("stair_curriculum_window", &p.stair_curriculum_window, 1, kMaxEpisodes,
         "the last this-many training episodes at each height give its failure rate (stair_curriculum)");
+  f.add("config_energy_weight", &p.config_energy_weight, -1.0, 10.0,
+        "per J; R2's energy weight sigma3 in the returns the DQN learns from before the refit; negative = "
+        "env.task.r2.sigma3 (the refit, logs and F(H) keep the task's)");
   f.add("pilot_gait_per_modules", &p.pilot_gait_per_modules,
         "the pilot climbs with each chain length's searched gait (else one gait for all)");
   f.add("pilot_flat_steering", &p.pilot_flat_steering,

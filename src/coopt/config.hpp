@@ -121,6 +121,13 @@ struct TrainerParams {
   // More practice where the run fails, from its own outcomes only.
   double stair_curriculum = 0;
   int stair_curriculum_window = 50;
+  // R2's energy weight (sigma3, per J of stair energy) in the returns the
+  // configuration model learns from before the DQN refit; negative = the
+  // task's (env.task.r2.sigma3). The refit, the logs and F(H) keep the task's.
+  // The DQN that picks the training episodes' chains decides what data the
+  // motion model gets; with a heavy weight it prefers a short chain that
+  // fails cheaply to a long one that is learning to climb.
+  double config_energy_weight = -1;
   // The refit's first refit_sweep_scenes x 9 episodes play each of that many
   // scenes once per chain length, the first configuration forced in turn (the
   // later ones the DQN's). Every (stair height, chain) pair then gets samples

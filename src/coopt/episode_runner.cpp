@@ -174,6 +174,12 @@ control::MotionMode mode_of(int scene) {
   return scene == sim::kLabelStairs ? control::MotionMode::stair : control::MotionMode::flat;
 }
 
+// The segment's R2 as the configuration model is paid it: `r2` (env.task.r2) unless the hooks set another.
+float learned_r2(const LearnHooks* hooks, const Segment& segment, const task::MultiTaskEnv& env, double r2) {
+  if (hooks->config_r2) r2 = segment.r2(*hooks->config_r2, env.stair_height(), env.stairs_energy());
+  return static_cast<float>(r2);
+}
+
 void record_first_segment(const CooptConfig& c, const task::MultiTaskEnv& env, const Segment& segment,
                           EpisodeLog& log) {
   log.first_segment_R2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
@@ -299,7 +305,8 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
     const double r2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
     return_r2 += r2;
     fill_config(env, t, scene.current(), b, b.cnext);
-    if (hooks) hooks->config(b.cobs, b.caction, static_cast<float>(r2), b.cnext, false, false, segment.steps());
+    if (hooks)
+      hooks->config(b.cobs, b.caction, learned_r2(hooks, segment, env, r2), b.cnext, false, false, segment.steps());
     std::swap(b.cobs, b.cnext);
     const Configuration& next = choose(b.cobs);
     lap(kDqn);
@@ -320,7 +327,8 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
     return_r2 += r2;
     fill_config(env, t, scene.current(), b, b.cnext);
     if (hooks)
-      hooks->config(b.cobs, b.caction, static_cast<float>(r2), b.cnext, r->terminated, r->truncated, segment.steps());
+      hooks->config(b.cobs, b.caction, learned_r2(hooks, segment, env, r2), b.cnext, r->terminated, r->truncated,
+                    segment.steps());
     lap(kDqn);
   }
 

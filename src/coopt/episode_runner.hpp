@@ -120,6 +120,8 @@ struct LearnHooks {
   std::function<void(bool)> stepped;
   std::function<void(const rl::Observation&, const rl::Action&, float, const rl::Observation&, bool, bool, int)>
       config;
+  // The R2 that `config` is paid (trainer.config_energy_weight); null: env.task.r2.
+  const task::R2Params* config_r2 = nullptr;
   std::function<int(const std::vector<std::uint8_t>&)> random_config;  // warm-up choice, -1 = ask the DQN
   // The scripted pilot, when set, plans every episode and gives each step's
   // action as the transition's behaviour-cloning target (Action::target); with

@@ -4,11 +4,13 @@
 // evaluator, the CLI's bad-input handling, and a learning test.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -432,6 +434,34 @@ TEST(Trainer, StairCurriculumDrawsTrainingHeightsFromTheRunsOutcomesAndResumesTo
   EXPECT_THROW(load_coopt_config(kCi, {"trainer.stair_curriculum=0.5", "trainer.stair_height=0.06"}),
                std::runtime_error);
   for (const std::string& d : {plain_dir, full_dir, dir, threads_a, threads_b}) fs::remove_all(d);
+}
+
+// trainer.config_energy_weight: before the refit the DQN is paid R2 with that
+// energy weight (0: stair energy costs nothing, so a segment pays at least the
+// task's R2, and one with stair energy more); the refit and the logs keep the task's.
+TEST(Trainer, ConfigEnergyWeightPaysTheTrainingDqnItsOwnR2AndTheRefitTheTasks) {
+  const std::vector<std::string> sets{"trainer.config_refit_episodes=2", "trainer.config_energy_weight=0"};
+  const std::string dir = temp_dir("energy_weight");
+  const RunResult r = run_ci(sets, dir);
+  const CooptConfig c = load_coopt_config(kCi, sets);
+  ASSERT_GT(c.env.task.r2.sigma3, 0);
+  std::map<int, double> paid;  // per episode, the summed R2 of its decisions
+  for (const DecisionLog& d : r.decisions) paid[d.episode] += d.r2;
+  int cheaper = 0, refit = 0;
+  for (const EpisodeLog& l : r.logs) {
+    if (!paid.count(l.episode)) continue;
+    const double tolerance = 1e-3 * std::max(1.0, std::abs(l.return_R2));
+    if (l.episode >= c.trainer.refit_start()) {
+      EXPECT_NEAR(paid[l.episode], l.return_R2, tolerance) << "refit episode " << l.episode;
+      ++refit;
+    } else {
+      EXPECT_GE(paid[l.episode], l.return_R2 - tolerance) << "episode " << l.episode;
+      cheaper += paid[l.episode] > l.return_R2 + tolerance;
+    }
+  }
+  EXPECT_EQ(refit, 2);
+  EXPECT_GT(cheaper, 0) << "no training decision was paid without the stair energy's cost";
+  fs::remove_all(dir);
 }
 
 // trainer.simulation_threads: the threads step in rounds whose hand-over
