@@ -18,6 +18,11 @@ void copy_transition(const Transition& from, Transition& to) {
   to.set(from.obs, from.action, from.reward, from.next, from.terminated, from.truncated, from.steps);
 }
 
+// The training episodes the stair curriculum draws heights for and learns from: after the warm-up, before the refit.
+bool curriculum_episode(const TrainerParams& t, int episode) {
+  return t.stair_curriculum > 0 && episode >= t.warmup_episodes && episode < t.refit_start();
+}
+
 }  // namespace
 
 LearnerHost::LearnerHost(const CooptConfig& c, const std::string& run_dir, TrainerCallbacks callbacks, int actors)
@@ -98,7 +103,7 @@ Orders LearnerHost::start_orders(int episode) const {
     o.motion_counters = {state_.steps, episode, 0};
   }
   const TrainerParams& t = config_.trainer;
-  if (t.stair_curriculum > 0 && episode >= t.warmup_episodes && episode < t.refit_start())
+  if (curriculum_episode(t, episode))
     o.stair_height_m = state_.curriculum.draw(height_weights_, stream_seed(t.seed, episode, 3));
   return o;
 }
@@ -315,7 +320,7 @@ void LearnerHost::take_motion_model(const std::string& run_dir) {
 
 void LearnerHost::log_episode(const EpisodeLog& log) {
   const TrainerParams& t = config_.trainer;
-  if (!log.warmup && log.episode < t.refit_start()) state_.curriculum.record(log.stair_height_m, log.success);
+  if (curriculum_episode(t, log.episode)) state_.curriculum.record(log.stair_height_m, log.success);
   store_.append_episode(log);
   if (callbacks_.on_episode) callbacks_.on_episode(log);
   progress(log);
@@ -342,7 +347,7 @@ void LearnerHost::progress(const EpisodeLog& log) {
   const double eta_s = episode_s * (total - episode);
   const std::string configs = task::configuration_sequence(log.configurations);
   std::string curriculum;  // the next training episodes' stair-height probabilities
-  if (t.stair_curriculum > 0 && episode >= t.warmup_episodes && episode < t.refit_start()) {
+  if (curriculum_episode(t, episode)) {
     curriculum = " | heights drawn";
     const std::vector<double> weights = state_.curriculum.weights(t.stair_curriculum);
     for (std::size_t i = 0; i < weights.size(); ++i) {
