@@ -19,6 +19,8 @@ void add_fields(YamlFields& f, TaskParams& p) {
   f.add("r2.s_base", &p.r2.s_base, 1e-3, 1, "R2: m, sigma2 = 1 + stair height / s_base on the stairs");
   f.add("r2.r_s", &p.r2.r_s, 0, 1e5, "R2: reward when the stairs are climbed in the segment");
   f.add("r2.sigma3", &p.r2.sigma3, 0, 10, "R2: weight per J of the energy spent on the stairs");
+  f.add("r2.energy_if_climbed", &p.r2.energy_if_climbed,
+        "R2: only the segment that climbed the stairs pays sigma3 x its stair energy (a failed climb pays none)");
   f.add("objective.w_t", &p.objective.w_t, 0, 100, "F(H) (Eq. 1): weight of the time T");
   f.add("objective.w_e", &p.objective.w_e, 0, 100, "F(H): weight of the energy E");
   f.add("objective.w_d", &p.objective.w_d, 0, 100, "F(H): weight of the distance fraction D");

@@ -25,11 +25,16 @@ struct R2Params {
   double s_base = 0.04;    // m, stair height normaliser of sigma2
   double r_s = 60.0;       // reward when the stairs are climbed in the segment
   double sigma3 = 0.003;   // per J of stair energy
+  // The paper's r_c is "the energy consumed when passing through the stair".
+  // false: every stairs segment pays for its stair energy, climbed or not;
+  // true: only the segment that climbed them does (a failed climb's r_c = 0), so a
+  // short failed attempt is not cheaper than a long failed one.
+  bool energy_if_climbed = false;
 };
 
 // Eq. 7 for one segment. stairs_segment: the segment started before the stairs
 // were climbed; stairs_climbed: r_s was earned in it; stair_energy_J: E_c, the
-// joules spent on the stairs during the segment.
+// joules spent on the stairs during the segment (charged per p.energy_if_climbed).
 double r2_reward(const R2Params& p, double sum_r1, bool stairs_segment, bool stairs_climbed,
                  double stair_height_m, double stair_energy_J);
 

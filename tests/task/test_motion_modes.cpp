@@ -92,6 +92,10 @@ TEST(Rewards, R2AndObjective) {
   EXPECT_NEAR(task::r2_reward(p, 50.0, true, true, 0.08, 1000.0), 50.0 + 3.0 * 60.0 - 3.0, 1e-12);
   EXPECT_NEAR(task::r2_reward(p, 50.0, true, false, 0.08, 1000.0), 50.0 - 3.0, 1e-12);
   EXPECT_NEAR(task::r2_reward(p, 50.0, false, true, 0.08, 1000.0), 50.0, 1e-12);  // after the stairs
+  task::R2Params on_climb = p;
+  on_climb.energy_if_climbed = true;  // a failed climb pays no energy, a climb pays as before
+  EXPECT_NEAR(task::r2_reward(on_climb, 50.0, true, false, 0.08, 1000.0), 50.0, 1e-12);
+  EXPECT_NEAR(task::r2_reward(on_climb, 50.0, true, true, 0.08, 1000.0), 50.0 + 3.0 * 60.0 - 3.0, 1e-12);
   const task::ObjectiveWeights w{2.0, 3.0, 4.0, 120.0, 20000.0};
   // T = 60 s / 120 s = 0.5, E = 2000 J / 20000 J = 0.1, D = 0.9.
   EXPECT_NEAR(task::objective(w, 60.0, 2000.0, 0.9), -1.0 - 0.3 + 3.6, 1e-12);
