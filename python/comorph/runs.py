@@ -31,11 +31,14 @@ class Run:
         return MultiTaskEnv(modules=modules, scenario=scenario or self._run.scenario, obstacles=obstacles,
                             render_mode=render_mode, _env_config=self._run.env_config())
 
-    def choose_modules(self, image, max_modules=10, scene=0):
+    def choose_modules(self, image, max_modules=10, scene=0, target_distance_m=None):
         """The configuration model's greedy choice of modules (2..max_modules) for
         its image (env.decision_depth() when the run uses the decision camera,
-        else obs["depth"]), the largest allowed chain C_n and the scene label."""
-        return self._run.choose_modules(np.asarray(image, np.float32), int(max_modules), int(scene))
+        else obs["depth"]), the largest allowed chain C_n and the scene label.
+        A run trained with trainer.config_target_distance also needs
+        info["target_distance_m"]; other runs ignore it."""
+        d = -1.0 if target_distance_m is None else float(target_distance_m)
+        return self._run.choose_modules(np.asarray(image, np.float32), int(max_modules), int(scene), d)
 
     def act(self, obs):
         """The motion model's greedy action (float32 (5,)) for an env observation."""

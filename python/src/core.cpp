@@ -175,6 +175,7 @@ class PyEnv {
     info["seed"] = core_.episode_seed();
     info["stair_height"] = e.stair_height();
     info["stairs_climbed"] = e.stairs_climbed();
+    info["target_distance_m"] = e.target_distance();
   }
   static void metrics_into(const task::EpisodeMetrics& m, py::dict& d) {
     for (const MetricField& f : kMetricFields) d[f.key] = f.get(m);

@@ -49,9 +49,9 @@ class Run {
       : dir_(run_dir), config_(load_run_config(run_dir)), policy_(config_, run_dir),
         spec_(task::MultiTaskEnv::spec(config_.env)) {}
 
-  int choose_modules(const FloatArray& image, int max_modules, int scene) {
+  int choose_modules(const FloatArray& image, int max_modules, int scene, double target_distance_m) {
     const float* p = floats_of(image, policy_.decision_image_size(), "image");
-    return policy_.choose_modules(p, max_modules, scene);
+    return policy_.choose_modules(p, max_modules, scene, target_distance_m);
   }
 
   FloatArray act(const FloatArray& depth, const FloatArray& state, const FloatArray& clearance) {
@@ -104,7 +104,8 @@ PYBIND11_MODULE(_runs, m) {
   m.doc() = "comorph's trained runs: greedy policies and evaluation (LibTorch; docs/python.md)";
   py::class_<Run>(m, "Run")
       .def(py::init<const std::string&>(), py::arg("path"))
-      .def("choose_modules", &Run::choose_modules, py::arg("image"), py::arg("max_modules"), py::arg("scene"))
+      .def("choose_modules", &Run::choose_modules, py::arg("image"), py::arg("max_modules"), py::arg("scene"),
+           py::arg("target_distance_m") = -1.0)
       .def("act", &Run::act, py::arg("depth"), py::arg("state"), py::arg("clearance"))
       .def("env_config", &Run::env_config)
       .def_property_readonly("hierarchical", &Run::hierarchical)

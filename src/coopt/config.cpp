@@ -88,6 +88,8 @@ void add_fields(YamlFields& f, TrainerParams& p) {
         "mpirun the other ranks are the actors)");
   f.add("motion_image", &p.motion_image, "the motion model sees the depth image (CNN) beside the state");
   f.add("config_vector", &p.config_vector, "the DQN sees [C_n / 10, scene one-hot] beside its image");
+  f.add("config_target_distance", &p.config_target_distance,
+        "the DQN also sees module 1's distance to the target (m / 10) after config_vector's values");
   f.add("motion_clearance", &p.motion_clearance,
         "the motion model sees the clearance row (nearest depth per column, or the obstacle scan)");
   f.add("motion_heads_per_chain", &p.motion_heads_per_chain,
@@ -178,6 +180,8 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
                                                       quote_value(p.motion_algo) + "'");
   if (p.config_learns_from == ConfigLearnsFrom::greedy && p.greedy_motion_interval < 1)
     fail(source, pre + ".config_learns_from", "greedy needs trainer.greedy_motion_interval >= 1");
+  if (p.config_target_distance && !p.config_vector)
+    fail(source, pre + ".config_target_distance", "needs trainer.config_vector true (the distance follows its values)");
   if (!p.refit_motion_from.empty()) {
     if (p.warmup_episodes != 0 || p.episodes != 0 || p.config_refit_episodes < 1)
       fail(source, pre + ".refit_motion_from",

@@ -98,6 +98,12 @@ struct TrainerParams {
   bool motion_heads_per_chain = false;
   bool normalize_state = false;       // scale the state vector's fields to about [-1, 1] (fixed factors, trainer.cpp)
   bool config_vector = true;          // the DQN sees [C_n / 10, scene one-hot x3] beside the depth image
+  // The DQN also sees how far module 1 still is from the target (m / 10),
+  // appended to config_vector's. A bootstrapped target (config_target
+  // bootstrap) can then value what is left of the course after the stairs: a
+  // longer chain ends the stairs segment farther along, and the image does not
+  // show it. The distance says nothing of the stair height or the obstacles.
+  bool config_target_distance = false;
   bool decision_camera = false;       // the DQN sees the decision camera (env.robot.decision_*), not the motion camera
   // Who drives the motion during the warm-up: "random" (uniform actions, the
   // paper) or "scripted" (task::ScriptedPilot, which plans on the true obstacle

@@ -64,7 +64,7 @@ rl::ObservationSpec config_spec(const CooptConfig& c) {
   s.image_channels = 1;
   s.image_height = c.trainer.decision_camera ? c.env.robot.decision_depth_height : c.env.robot.depth_height;
   s.image_width = c.trainer.decision_camera ? c.env.robot.decision_depth_width : c.env.robot.depth_width;
-  s.vector_size = c.trainer.config_vector ? kConfigVector : 0;
+  s.vector_size = c.trainer.config_vector ? kConfigVector + (c.trainer.config_target_distance ? 1 : 0) : 0;
   return s;
 }
 
@@ -144,12 +144,17 @@ void fill_motion(const float* depth, const float* state, const float* clearance,
   }
 }
 
-void fill_config_vector(const TrainerParams& t, const Configuration& current, int scene,
+void fill_config_vector(const TrainerParams& t, const Configuration& current, int scene, double target_distance_m,
                         std::vector<std::uint8_t>& mask, rl::Observation& o) {
-  const bool vector = t.config_vector;
-  if (vector) {
+  if (t.config_vector) {
     o.vector[0] = static_cast<float>(modules_of(candidate_index(current))) / kMaxModules;
     for (int k = 0; k < 3; ++k) o.vector[1 + k] = scene == k ? 1.0f : 0.0f;
+    if (t.config_target_distance) {
+      if (!(target_distance_m >= 0))
+        throw std::invalid_argument("trainer.config_target_distance: the DQN needs the distance to the target, got " +
+                                    std::to_string(target_distance_m) + " m");
+      o.vector[kConfigVector] = static_cast<float>(target_distance_m / 10.0);
+    }
   }
   candidate_mask(current, mask);
   o.valid_actions = mask;
@@ -167,7 +172,7 @@ void fill_config(const task::MultiTaskEnv& env, const TrainerParams& t, int scen
     env.render_decision_depth(o.image.data());
   else
     std::copy(env.depth(), env.depth() + o.image.size(), o.image.begin());
-  fill_config_vector(t, env.configuration(), scene, b.mask, o);
+  fill_config_vector(t, env.configuration(), scene, env.target_distance(), b.mask, o);
 }
 
 control::MotionMode mode_of(int scene) {

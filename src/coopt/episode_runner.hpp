@@ -70,10 +70,11 @@ rl::ObservationSpec config_spec(const CooptConfig& c);
 // clearance row if asked.
 void fill_motion(const float* depth, const float* state, const float* clearance, const TrainerParams& t,
                  rl::Observation& o);
-// The configuration model's vector [C_n / 10, scene one-hot] and mask (the
-// current configuration and those it can shed modules to; `mask` is its
-// storage); the image is already in o.image.
-void fill_config_vector(const TrainerParams& t, const Configuration& current, int scene,
+// The configuration model's vector [C_n / 10, scene one-hot] (then the
+// distance to the target / 10 m with trainer.config_target_distance; it must
+// be >= 0 then) and mask (the current configuration and those it can shed
+// modules to; `mask` is its storage); the image is already in o.image.
+void fill_config_vector(const TrainerParams& t, const Configuration& current, int scene, double target_distance_m,
                         std::vector<std::uint8_t>& mask, rl::Observation& o);
 
 // The scene spec of evaluation episode i (heights cycle 0.04, 0.06, 0.08).

@@ -162,7 +162,7 @@ bool GreedyPolicy::hierarchical() const { return impl_->agent.config != nullptr;
 
 int GreedyPolicy::decision_image_size() const { return config_spec(impl_->config).image_size(); }
 
-int GreedyPolicy::choose_modules(const float* image, int max_modules, int scene) {
+int GreedyPolicy::choose_modules(const float* image, int max_modules, int scene, double target_distance_m) {
   if (!impl_->agent.config) throw std::logic_error("GreedyPolicy::choose_modules: the run has no configuration model");
   if (max_modules < kMinModules || max_modules > kMaxModules)
     throw std::invalid_argument("max_modules must be in " + std::to_string(kMinModules) + ".." +
@@ -170,7 +170,8 @@ int GreedyPolicy::choose_modules(const float* image, int max_modules, int scene)
   if (scene < 0 || scene > 2) throw std::invalid_argument("scene must be 0, 1 or 2, got " + std::to_string(scene));
   Buffers& b = impl_->buffers;
   std::copy(image, image + b.cobs.image.size(), b.cobs.image.begin());
-  fill_config_vector(impl_->config.trainer, candidates()[candidate_of(max_modules)], scene, b.mask, b.cobs);
+  fill_config_vector(impl_->config.trainer, candidates()[candidate_of(max_modules)], scene, target_distance_m, b.mask,
+                     b.cobs);
   impl_->agent.config->act(b.cobs, false, b.caction);
   return modules_of(b.caction.discrete);
 }

@@ -297,8 +297,10 @@ class GreedyPolicy {
   // (MultiTaskEnv::render_decision_depth) with trainer.decision_camera, else depth().
   int decision_image_size() const;
   // The configuration model's greedy choice of modules in [2, max_modules]
-  // for that image, the largest allowed chain C_n and the scene (sim::SceneLabel).
-  int choose_modules(const float* image, int max_modules, int scene);
+  // for that image, the largest allowed chain C_n and the scene (sim::SceneLabel);
+  // target_distance_m (MultiTaskEnv::target_distance) is needed by a run with
+  // trainer.config_target_distance and ignored by others.
+  int choose_modules(const float* image, int max_modules, int scene, double target_distance_m = -1);
   // The motion model's greedy action (control::kActionSize floats) for the
   // env's depth(), state() and clearance().
   void act(const float* depth, const float* state, const float* clearance, float* action);

@@ -63,6 +63,11 @@ double MultiTaskEnv::goal_distance() const {
   return std::hypot(gx - head[0], gy - head[1]);
 }
 
+double MultiTaskEnv::target_distance() const {
+  const double* head = world_.module_pos(0);
+  return std::hypot(world_.layout().target_x - head[0], world_.layout().target_y - head[1]);
+}
+
 control::MotionMode MultiTaskEnv::default_mode() const {
   return stairs_climbed() ? control::MotionMode::flat : control::MotionMode::stair;
 }
@@ -217,9 +222,7 @@ EpisodeMetrics MultiTaskEnv::metrics() const {
   m.time_s = steps_ * config_.robot.control_period;
   m.energy_J = world_.energy_used();
   m.initial_distance_m = initial_distance_;
-  const double* head = world_.module_pos(0);
-  const double now = std::hypot(world_.layout().target_x - head[0], world_.layout().target_y - head[1]);
-  m.distance_done_m = std::max(0.0, initial_distance_ - now);
+  m.distance_done_m = std::max(0.0, initial_distance_ - target_distance());
   const ObjectiveWeights& w = config_.task.objective;
   m.T = m.time_s / w.t_max_s;
   m.E = m.energy_J / w.energy_scale_J;

@@ -169,6 +169,7 @@ class MultiTaskEnv {
   const StepOutcome& last() const { return result_; }
   control::MotionMode mode() const { return mode_; }
   void goal(double& x, double& y) const;                    // current goal (m)
+  double target_distance() const;                          // m, module 1 -> the target, horizontal
 
   const sim::World& world() const { return world_; }
   sim::World& mutable_world() { return world_; }  // tools and tests (e.g. depth from arbitrary poses)

@@ -12,6 +12,7 @@
 #include "coopt/acting.hpp"
 #include "coopt/config.hpp"
 #include "coopt/config_reference.hpp"
+#include "coopt/episode_runner.hpp"
 #include "coopt/segment.hpp"
 #include "coopt/stair_curriculum.hpp"
 #include "coopt/training_state.hpp"
@@ -329,6 +330,25 @@ TEST(CooptConfig, UnknownKeysAndOutOfRangeValuesNameTheKey) {
   expect_error({"td3.random_action_episodes=5"}, "warmup_episodes");
   expect_error({"nosection.x=1"}, "nosection");
   expect_error({"trainer.episodes"}, "key=value");
+  expect_error({"trainer.config_target_distance=true", "trainer.config_vector=false"}, "trainer.config_target_distance");
+}
+
+// trainer.config_target_distance: the DQN's vector gains the distance to the target, in units of 10 m.
+TEST(ConfigVector, TargetDistanceFollowsTheChainLengthAndTheScene) {
+  const CooptConfig plain = load_coopt_config(kCi);
+  const CooptConfig with = load_coopt_config(kCi, {"trainer.config_target_distance=true"});
+  ASSERT_EQ(config_spec(with).vector_size, config_spec(plain).vector_size + 1);
+  rl::Observation o;
+  rl::allocate(config_spec(with), o);
+  std::vector<std::uint8_t> mask;
+  fill_config_vector(with.trainer, make_chain(6), 1, 4.2, mask, o);
+  EXPECT_FLOAT_EQ(o.vector[0], 0.6f);  // C_n / 10
+  EXPECT_FLOAT_EQ(o.vector[2], 1.0f);  // scene 1
+  EXPECT_FLOAT_EQ(o.vector.back(), 0.42f);
+  EXPECT_THROW(fill_config_vector(with.trainer, make_chain(6), 1, -1.0, mask, o), std::invalid_argument);
+  rl::allocate(config_spec(plain), o);
+  fill_config_vector(plain.trainer, make_chain(6), 1, -1.0, mask, o);  // not asked for: not needed
+  EXPECT_EQ(o.vector.size(), 4u);
 }
 
 // dqn_refit: holds only the keys in which the refit DQN differs from dqn:.
