@@ -11,7 +11,7 @@ namespace comorph::rl {
 namespace {
 
 QNetwork make_network(const ObservationSpec& spec, int num_actions, const DqnConfig& c) {
-  QNetwork q(spec, num_actions, c.hidden_sizes, c.image_features, c.image_fc_size);
+  QNetwork q(spec, num_actions, c.hidden_sizes, c.image_features, c.image_fc_size, c.ensemble_size);
   q->to(torch::Device(c.device));
   return q;
 }
@@ -101,9 +101,16 @@ torch::Tensor Dqn::td_target(const ReplayBatch& b) {
 void Dqn::update() {
   const ReplayBatch b = replay_.sample(config_.batch_size, rng_, device_);
   const torch::Tensor target = td_target(b);
-  const torch::Tensor q = q_->forward(b.image, b.vector).gather(1, b.action.unsqueeze(1)).squeeze(1);
-  const torch::Tensor loss = config_.loss == DqnLoss::huber ? torch::smooth_l1_loss(q, target)
-                                                             : torch::mse_loss(q, target);
+  // Each member regresses on the (shared) target: the mean of the members' losses.
+  const int members = q_->members();
+  const torch::Tensor q =
+      members == 1 ? q_->forward(b.image, b.vector).gather(1, b.action.unsqueeze(1)).squeeze(1)
+                   : q_->forward_members(b.image, b.vector)
+                         .gather(2, b.action.view({1, -1, 1}).expand({members, -1, 1}))
+                         .squeeze(2);
+  const torch::Tensor expanded = members == 1 ? target : target.unsqueeze(0).expand_as(q);
+  const torch::Tensor loss = config_.loss == DqnLoss::huber ? torch::smooth_l1_loss(q, expanded)
+                                                             : torch::mse_loss(q, expanded);
   gradient_step(*optimizer_, loss, config_.max_grad_norm);
   last_loss_ = loss.item<double>();
   ++counters_.updates;

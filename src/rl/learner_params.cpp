@@ -49,6 +49,8 @@ void add_fields(YamlFields& f, DqnConfig& c) {
                       "probability of a random choice", "stored transitions");
   f.add("loss", &c.loss, "loss on the TD error: huber (smooth L1, delta 1) or mse (squared)");
   f.add("double_dqn", &c.double_dqn, "pick the next action with the online network (double DQN)");
+  f.add("ensemble_size", &c.ensemble_size, 1, 64,
+        "Q networks trained on the same batches from their own initial weights; acting and targets use their mean");
 }
 
 void add_fields(YamlFields& f, Td3Config& c) {

@@ -86,18 +86,36 @@ double ObservationEncoderImpl::forward_flops() const {
   return cnn_.is_empty() ? 0.0 : cnn_->forward_flops();
 }
 
-QNetworkImpl::QNetworkImpl(const ObservationSpec& spec, int num_actions,
-                           const std::vector<int>& hidden_sizes, int image_features, int fc_size) {
+QNetworkImpl::QNetworkImpl(const ObservationSpec& spec, int num_actions, const std::vector<int>& hidden_sizes,
+                           int image_features, int fc_size, int members) {
+  if (members < 1) throw std::invalid_argument("QNetwork: members must be >= 1, got " + std::to_string(members));
   const bool paper_image_net = spec.has_image() && !spec.has_vector() && hidden_sizes.empty();
-  encoder_ = register_module(
-      "encoder", ObservationEncoder(spec, paper_image_net ? num_actions : image_features, fc_size));
-  if (!paper_image_net)
-    head_ = register_module("head", Mlp(encoder_->output_size(), hidden_sizes, num_actions));
+  for (int m = 0; m < members; ++m) {
+    const std::string prefix = m == 0 ? "" : "member" + std::to_string(m) + "_";
+    encoders_.push_back(register_module(
+        prefix + "encoder", ObservationEncoder(spec, paper_image_net ? num_actions : image_features, fc_size)));
+    heads_.push_back(paper_image_net ? Mlp{nullptr}
+                                     : register_module(prefix + "head", Mlp(encoders_.back()->output_size(),
+                                                                             hidden_sizes, num_actions)));
+  }
+}
+
+torch::Tensor QNetworkImpl::forward_members(const torch::Tensor& image, const torch::Tensor& vector) {
+  std::vector<torch::Tensor> q;
+  q.reserve(encoders_.size());
+  for (std::size_t m = 0; m < encoders_.size(); ++m) {
+    torch::Tensor f = encoders_[m]->forward(image, vector);
+    q.push_back(heads_[m].is_empty() ? f : heads_[m]->forward(f));
+  }
+  return torch::stack(q);
 }
 
 torch::Tensor QNetworkImpl::forward(const torch::Tensor& image, const torch::Tensor& vector) {
-  torch::Tensor f = encoder_->forward(image, vector);
-  return head_.is_empty() ? f : head_->forward(f);
+  if (encoders_.size() == 1) {
+    torch::Tensor f = encoders_[0]->forward(image, vector);
+    return heads_[0].is_empty() ? f : heads_[0]->forward(f);
+  }
+  return forward_members(image, vector).mean(0);
 }
 
 void copy_parameters(torch::nn::Module& dst, const torch::nn::Module& src) {

@@ -72,13 +72,17 @@ TORCH_MODULE(ObservationEncoder);
 
 class QNetworkImpl : public torch::nn::Module {
  public:
+  // members > 1: an ensemble of that many networks of this architecture
+  // (member 0 registered as a single network is, so its checkpoints read alike).
   QNetworkImpl(const ObservationSpec& spec, int num_actions, const std::vector<int>& hidden_sizes,
-               int image_features, int fc_size = 256);
-  torch::Tensor forward(const torch::Tensor& image, const torch::Tensor& vector);  // [B, n]
+               int image_features, int fc_size = 256, int members = 1);
+  torch::Tensor forward(const torch::Tensor& image, const torch::Tensor& vector);  // [B, n], the members' mean
+  torch::Tensor forward_members(const torch::Tensor& image, const torch::Tensor& vector);  // [members, B, n]
+  int members() const { return static_cast<int>(encoders_.size()); }
 
  private:
-  ObservationEncoder encoder_{nullptr};
-  Mlp head_{nullptr};  // empty for the paper's image-only network
+  std::vector<ObservationEncoder> encoders_;
+  std::vector<Mlp> heads_;  // empty modules for the paper's image-only network
 };
 TORCH_MODULE(QNetwork);
 

@@ -261,6 +261,44 @@ TEST(Learning, DqnMseLearnsMeanReturnsWhereHuberLearnsMedians) {
   }
 }
 
+// The same bandit with an ensemble of three Q networks: every member learns
+// the means (each regresses on the target, not only their mean), so the
+// greedy choice is the sure chain.
+TEST(Learning, DqnEnsembleMembersEachLearnTheMeanReturns) {
+  const rl::ObservationSpec spec{0, 0, 0, 1};
+  rl::Observation o;
+  o.vector = {1.0f};
+  YAML::Node config = small_dqn();
+  config["loss"] = "mse";
+  config["train_frequency"] = 1;
+  config["ensemble_size"] = 3;
+  auto learner = rl::make_learner("dqn", spec, {rl::ActionKind::kDiscrete, 2}, config, "test", 1);
+  std::mt19937_64 rng(7);
+  std::bernoulli_distribution risky_pays(0.7);
+  rl::Action a;
+  for (int i = 0; i < 3000; ++i) {
+    a.discrete = i % 2;
+    const float r = a.discrete == 0 ? (risky_pays(rng) ? 10.0f : 0.0f) : 9.0f;
+    learner->store(o, a, r, o, /*terminated=*/true, false);
+    for (int u = learner->updates_due(); u > 0; --u) learner->update();
+  }
+  auto& dqn = static_cast<rl::Dqn&>(*learner);
+  torch::NoGradGuard no_grad;
+  const torch::Tensor members =
+      dqn.target_network()->forward_members(torch::Tensor(), torch::ones({1, 1}));  // [3, 1, 2]
+  ASSERT_EQ(members.size(0), 3);
+  for (int m = 0; m < 3; ++m) {  // the target copy of each member (synced every 50 updates)
+    EXPECT_NEAR(members[m][0][0].item<float>(), 7.0, 1.0) << "member " << m;
+    EXPECT_NEAR(members[m][0][1].item<float>(), 9.0, 0.7) << "member " << m;
+  }
+  const std::vector<float> q = dqn.q_values(o);
+  EXPECT_NEAR(q[0], 7.0, 0.8);
+  EXPECT_NEAR(q[1], 9.0, 0.5);
+  rl::Action greedy;
+  dqn.act(o, /*explore=*/false, greedy);
+  EXPECT_EQ(greedy.discrete, 1);
+}
+
 TEST(Learning, Td3DrivesPointToOrigin) {
   PointEnv env, eval_env;
   env.seed(1);

@@ -257,6 +257,23 @@ TEST(Networks, QNetworkImageOnlyIsThePaperNetAndTakesImagePlusVector) {
   EXPECT_EQ(q.sizes(), (std::vector<std::int64_t>{2, 9}));
 }
 
+TEST(Networks, QNetworkEnsembleAveragesItsMembersAndKeepsASingleNetworksNames) {
+  const rl::ObservationSpec spec{1, 16, 16, 5};
+  rl::QNetwork single(spec, 9, std::vector<int>{64}, 16, 32);
+  rl::QNetwork ensemble(spec, 9, std::vector<int>{64}, 16, 32, /*members=*/3);
+  EXPECT_EQ(ensemble->members(), 3);
+  EXPECT_EQ(ensemble->parameters().size(), 3 * single->parameters().size());
+  // Member 0 is named as a single network, so a one-member checkpoint reads as before.
+  const auto names = single->named_parameters().keys();
+  const auto ensemble_names = ensemble->named_parameters().keys();
+  for (std::size_t i = 0; i < names.size(); ++i) EXPECT_EQ(ensemble_names[i], names[i]);
+  const torch::Tensor image = torch::rand({4, 1, 16, 16}), vector = torch::rand({4, 5});
+  const torch::Tensor members = ensemble->forward_members(image, vector);
+  EXPECT_EQ(members.sizes(), (std::vector<std::int64_t>{3, 4, 9}));
+  EXPECT_TRUE(torch::allclose(ensemble->forward(image, vector), members.mean(0)));
+  EXPECT_FALSE(torch::allclose(members[0], members[1]));  // own initial weights
+}
+
 TEST(Networks, SharedEncoderGetsNoGradientFromTheActor) {
   rl::ActorCritic nets(rl::ObservationSpec{1, 16, 16, 4}, 5, 5, std::vector<int>{32}, 16, 256, /*share_encoder=*/true);
   const torch::Tensor image = torch::rand({4, 1, 16, 16}), vector = torch::rand({4, 4});
