@@ -387,11 +387,6 @@ CooptConfig config_from_tree(YAML::Node root, const std::string& source, const s
       throw std::runtime_error(src + ": dqn_refit: expected a mapping of dqn keys" + line_of(root["dqn_refit"]));
     for (const auto& kv : root["dqn_refit"]) merged[kv.first.Scalar()] = kv.second;
     c.dqn_refit = rl::DqnConfig::from_yaml(merged, src + ": dqn_refit (over dqn)");
-    if (c.dqn_refit.hidden_sizes != c.dqn.hidden_sizes || c.dqn_refit.image_features != c.dqn.image_features ||
-        c.dqn_refit.image_fc_size != c.dqn.image_fc_size || c.dqn_refit.ensemble_size != c.dqn.ensemble_size)
-      throw std::runtime_error(src + ": dqn_refit: hidden_sizes, image_features, image_fc_size and ensemble_size "
-                                     "must be dqn:'s "
-                                     "(evaluation and export load the training or the refit DQN alike)");
   }
   if (given("td3") && (c.td3.random_action_episodes != 0 || c.td3.random_action_steps != 0))
     throw std::runtime_error(src + ": field 'td3.random_action_episodes/steps': must be 0, "

@@ -186,6 +186,8 @@ struct TrainerParams {
   std::string refit_motion_from;
   // Episode index of the refit's first episode (= warm-up + training episodes).
   int refit_start() const { return warmup_episodes + episodes; }
+  // A checkpoint after this many episodes holds the refit DQN (built with dqn_refit:), not the training one.
+  bool holds_refit_dqn(int episodes_done) const { return episodes_done > refit_start(); }
   int total_episodes() const { return refit_start() + config_refit_episodes; }
   // Every training transition carries the pilot's action for its state as a
   // behaviour-cloning target (td3.bc_weight), also where the motion model drove:

@@ -35,7 +35,7 @@ CheckpointInfo open_checkpoint_for_evaluation(const CooptConfig& config, const s
 void load_greedy_agent(const CooptConfig& c, const CheckpointInfo& checkpoint, Agent& agent) {
   agent.motion = make_motion_policy(c, 1);
   load_learner_file(*agent.motion, (fs::path(checkpoint.directory) / "motion_actor.pt").string());
-  agent.config = make_config_policy(c, false);
+  agent.config = make_config_policy(c, c.trainer.holds_refit_dqn(checkpoint.episodes));
   if (agent.config) load_learner_file(*agent.config, (fs::path(checkpoint.directory) / "config_model.pt").string());
 }
 

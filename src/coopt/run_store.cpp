@@ -373,7 +373,7 @@ void RunStore::load_checkpoint(TrainingState& s, const CooptConfig& config) cons
   load_learner_file(*s.agent.motion, (fs::path(info.directory) / "motion_actor.pt").string());
   if (s.config) {
     // Inside the DQN refit the checkpoint holds the refit DQN: built with its own hyperparameters.
-    if (info.episodes > config.trainer.refit_start()) s.start_refit(config);
+    if (config.trainer.holds_refit_dqn(info.episodes)) s.start_refit(config);
     load_learner_file(*s.config, (fs::path(info.directory) / "config_model.pt").string());
     s.config_segments = load_replay(*s.config, "config_model", info.directory);
   }

@@ -283,13 +283,14 @@ TEST(Trainer, ConfigRefitTrainsAFreshDqnOnTheFrozenMotionModel) {
   plain_config.trainer.mode = refit_config.trainer.mode = TrainerMode::fixed;  // the motion model alone
   EXPECT_EQ(greedy_lines(plain_config, plain_dir), greedy_lines(refit_config, refit_dir));
 
-  // The refit DQN's own hyperparameters (dqn_refit:) train it, and a run
-  // resumed inside the refit rebuilds it with them: its final DQN is the
-  // uninterrupted run's, byte for byte.
+  // The refit DQN's own hyperparameters (dqn_refit:, its architecture too)
+  // train it, evaluation loads it, and a run resumed inside the refit rebuilds
+  // it with them: its final DQN is the uninterrupted run's, byte for byte.
   sets.insert(sets.end(), {"dqn_refit.loss=mse", "dqn_refit.learning_rate=0.01", "dqn_refit.learning_starts=1",
-                           "dqn_refit.batch_size=2"});
+                           "dqn_refit.batch_size=2", "dqn_refit.ensemble_size=2"});
   const std::string own_dir = temp_dir("refit_own");
   const RunResult own = run_ci(sets, own_dir);
+  EXPECT_EQ(greedy_lines(load_coopt_config(kCi, sets), own_dir).size(), 6u);
   const auto final_dqn = [](const std::string& dir) { return test_support::read_text(dir + "/checkpoint/config_model.pt"); };
   EXPECT_TRUE(final_dqn(own_dir) != final_dqn(refit_dir));  // (no dump of the files)
   const std::string dir = temp_dir("refit_resume");
