@@ -376,7 +376,13 @@ TEST(CooptConfig, DqnRefitOverlaysTheDqnSection) {
     EXPECT_EQ(load_coopt_config(kCi, {no_refit, "dqn_refit.loss=mse"}).text, load_coopt_config(kCi, {no_refit}).text)
         << no_refit;
   expect_error({"trainer.config_refit_episodes=2", "dqn_refit.los=mse"}, "dqn_refit (over dqn)");
-  expect_error({"trainer.config_refit_episodes=2", "dqn_refit.hidden_sizes=[9]"}, "dqn_refit: hidden_sizes");
+  // The refit DQN may have its own architecture (evaluation loads the one a checkpoint holds).
+  const CooptConfig own = load_coopt_config(kCi, {"trainer.config_refit_episodes=2", "dqn_refit.hidden_sizes=[9]",
+                                                  "dqn_refit.ensemble_size=3"});
+  EXPECT_EQ(own.dqn_refit.hidden_sizes, std::vector<int>{9});
+  EXPECT_EQ(own.dqn_refit.ensemble_size, 3);
+  EXPECT_EQ(own.dqn.hidden_sizes, plain.dqn.hidden_sizes);
+  EXPECT_EQ(own.dqn.ensemble_size, 1);
 }
 
 TEST(Scenario, NamesMapToObstaclesAndVariant) {
