@@ -231,24 +231,34 @@ TEST(Learning, DqnLearnsCorridorValues) {
 // regresses the median and prefers the risky chain; MSE learns the means and
 // prefers the sure one. The configuration model's returns (hundreds, with
 // stalls on the stairs among them) are in this regime (configs/standard.yaml).
+namespace {
+// A DQN (small_dqn + `extra`) trained on 3000 alternating tries of the two chains.
+std::unique_ptr<rl::Learner> dqn_on_risky_and_sure_chains(const rl::Observation& o, const YAML::Node& extra) {
+  YAML::Node config = small_dqn();
+  config["train_frequency"] = 1;
+  for (const auto& kv : extra) config[kv.first.Scalar()] = kv.second;
+  auto learner = rl::make_learner("dqn", rl::ObservationSpec{0, 0, 0, 1}, {rl::ActionKind::kDiscrete, 2}, config,
+                                  "test", 1);
+  std::mt19937_64 rng(7);
+  std::bernoulli_distribution risky_pays(0.7);
+  rl::Action a;
+  for (int i = 0; i < 3000; ++i) {
+    a.discrete = i % 2;
+    const float r = a.discrete == 0 ? (risky_pays(rng) ? 10.0f : 0.0f) : 9.0f;
+    learner->store(o, a, r, o, /*terminated=*/true, false);
+    for (int u = learner->updates_due(); u > 0; --u) learner->update();
+  }
+  return learner;
+}
+}  // namespace
+
 TEST(Learning, DqnMseLearnsMeanReturnsWhereHuberLearnsMedians) {
-  const rl::ObservationSpec spec{0, 0, 0, 1};
   rl::Observation o;
   o.vector = {1.0f};
   for (const char* loss : {"mse", "huber"}) {
-    YAML::Node config = small_dqn();
-    config["loss"] = loss;
-    config["train_frequency"] = 1;
-    auto learner = rl::make_learner("dqn", spec, {rl::ActionKind::kDiscrete, 2}, config, "test", 1);
-    std::mt19937_64 rng(7);
-    std::bernoulli_distribution risky_pays(0.7);
-    rl::Action a;
-    for (int i = 0; i < 3000; ++i) {
-      a.discrete = i % 2;
-      const float r = a.discrete == 0 ? (risky_pays(rng) ? 10.0f : 0.0f) : 9.0f;
-      learner->store(o, a, r, o, /*terminated=*/true, false);
-      for (int u = learner->updates_due(); u > 0; --u) learner->update();
-    }
+    YAML::Node extra;
+    extra["loss"] = loss;
+    auto learner = dqn_on_risky_and_sure_chains(o, extra);
     const std::vector<float> q = static_cast<rl::Dqn&>(*learner).q_values(o);
     if (std::string(loss) == "mse") {
       EXPECT_NEAR(q[0], 7.0, 0.8);
@@ -265,23 +275,12 @@ TEST(Learning, DqnMseLearnsMeanReturnsWhereHuberLearnsMedians) {
 // the means (each regresses on the target, not only their mean), so the
 // greedy choice is the sure chain.
 TEST(Learning, DqnEnsembleMembersEachLearnTheMeanReturns) {
-  const rl::ObservationSpec spec{0, 0, 0, 1};
   rl::Observation o;
   o.vector = {1.0f};
-  YAML::Node config = small_dqn();
-  config["loss"] = "mse";
-  config["train_frequency"] = 1;
-  config["ensemble_size"] = 3;
-  auto learner = rl::make_learner("dqn", spec, {rl::ActionKind::kDiscrete, 2}, config, "test", 1);
-  std::mt19937_64 rng(7);
-  std::bernoulli_distribution risky_pays(0.7);
-  rl::Action a;
-  for (int i = 0; i < 3000; ++i) {
-    a.discrete = i % 2;
-    const float r = a.discrete == 0 ? (risky_pays(rng) ? 10.0f : 0.0f) : 9.0f;
-    learner->store(o, a, r, o, /*terminated=*/true, false);
-    for (int u = learner->updates_due(); u > 0; --u) learner->update();
-  }
+  YAML::Node extra;
+  extra["loss"] = "mse";
+  extra["ensemble_size"] = 3;
+  auto learner = dqn_on_risky_and_sure_chains(o, extra);
   auto& dqn = static_cast<rl::Dqn&>(*learner);
   torch::NoGradGuard no_grad;
   const torch::Tensor members =
