@@ -101,16 +101,13 @@ torch::Tensor Dqn::td_target(const ReplayBatch& b) {
 void Dqn::update() {
   const ReplayBatch b = replay_.sample(config_.batch_size, rng_, device_);
   const torch::Tensor target = td_target(b);
-  // Each member regresses on the (shared) target: the mean of the members' losses.
-  const int members = q_->members();
-  const torch::Tensor q =
-      members == 1 ? q_->forward(b.image, b.vector).gather(1, b.action.unsqueeze(1)).squeeze(1)
-                   : q_->forward_members(b.image, b.vector)
-                         .gather(2, b.action.view({1, -1, 1}).expand({members, -1, 1}))
-                         .squeeze(2);
-  const torch::Tensor expanded = members == 1 ? target : target.unsqueeze(0).expand_as(q);
-  const torch::Tensor loss = config_.loss == DqnLoss::huber ? torch::smooth_l1_loss(q, expanded)
-                                                             : torch::mse_loss(q, expanded);
+  // Each member regresses on the (shared) target: the mean of the members' losses ([members, B]).
+  const torch::Tensor q = q_->forward_members(b.image, b.vector)
+                              .gather(2, b.action.view({1, -1, 1}).expand({q_->members(), -1, 1}))
+                              .squeeze(2);
+  const torch::Tensor targets = target.unsqueeze(0).expand_as(q);
+  const torch::Tensor loss = config_.loss == DqnLoss::huber ? torch::smooth_l1_loss(q, targets)
+                                                             : torch::mse_loss(q, targets);
   gradient_step(*optimizer_, loss, config_.max_grad_norm);
   last_loss_ = loss.item<double>();
   ++counters_.updates;

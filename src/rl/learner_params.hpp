@@ -104,9 +104,9 @@ struct DqnConfig {
   double max_grad_norm = 0;             // clip the gradient's L2 norm; 0 = off
   bool double_dqn = false;              // pick the next action with the online net
   // Q networks trained side by side from their own initial weights on the
-  // same batches; acting and targets use their mean. With few noisy returns
-  // per choice a single network's argmax follows what it memorised of each
-  // image; the members memorise differently and the mean keeps what they share.
+  // same batches; acting and targets use their mean: meant to average away
+  // what each member fits of one image's noisy return (docs/results.md: it
+  // steadied the refit's shed choice, but did not raise success).
   int ensemble_size = 1;
   std::vector<int> hidden_sizes{120, 84};  // MLP head; [] + image-only obs = paper's net
   int image_features = 256;             // CNN output size when an MLP head follows

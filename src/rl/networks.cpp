@@ -100,22 +100,20 @@ QNetworkImpl::QNetworkImpl(const ObservationSpec& spec, int num_actions, const s
   }
 }
 
+torch::Tensor QNetworkImpl::member_forward(std::size_t m, const torch::Tensor& image, const torch::Tensor& vector) {
+  torch::Tensor f = encoders_[m]->forward(image, vector);
+  return heads_[m].is_empty() ? f : heads_[m]->forward(f);
+}
+
 torch::Tensor QNetworkImpl::forward_members(const torch::Tensor& image, const torch::Tensor& vector) {
   std::vector<torch::Tensor> q;
   q.reserve(encoders_.size());
-  for (std::size_t m = 0; m < encoders_.size(); ++m) {
-    torch::Tensor f = encoders_[m]->forward(image, vector);
-    q.push_back(heads_[m].is_empty() ? f : heads_[m]->forward(f));
-  }
+  for (std::size_t m = 0; m < encoders_.size(); ++m) q.push_back(member_forward(m, image, vector));
   return torch::stack(q);
 }
 
 torch::Tensor QNetworkImpl::forward(const torch::Tensor& image, const torch::Tensor& vector) {
-  if (encoders_.size() == 1) {
-    torch::Tensor f = encoders_[0]->forward(image, vector);
-    return heads_[0].is_empty() ? f : heads_[0]->forward(f);
-  }
-  return forward_members(image, vector).mean(0);
+  return encoders_.size() == 1 ? member_forward(0, image, vector) : forward_members(image, vector).mean(0);
 }
 
 void copy_parameters(torch::nn::Module& dst, const torch::nn::Module& src) {

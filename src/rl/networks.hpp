@@ -81,6 +81,7 @@ class QNetworkImpl : public torch::nn::Module {
   int members() const { return static_cast<int>(encoders_.size()); }
 
  private:
+  torch::Tensor member_forward(std::size_t m, const torch::Tensor& image, const torch::Tensor& vector);
   std::vector<ObservationEncoder> encoders_;
   std::vector<Mlp> heads_;  // empty modules for the paper's image-only network
 };
