@@ -97,6 +97,8 @@ void add_fields(YamlFields& f, TrainerParams& p) {
         "to its vector (TD3 only)");
   f.add("normalize_state", &p.normalize_state, "scale the state's fields to about [-1, 1]");
   f.add("decision_camera", &p.decision_camera, "the DQN sees the decision camera (env.robot.decision_*)");
+  f.add("decision_image_first_only", &p.decision_image_first_only,
+        "the DQN sees its image only at the first decision; later ones see a blank image (needs config_vector)");
   f.add("warmup_policy", &p.warmup_policy,
         "who drives the warm-up: random (uniform actions, the paper) | scripted (the pilot, plus noise)");
   f.add("warmup_noise", &p.warmup_noise, 0.0, 2.0, "std of the noise on the pilot's actions, action units");
@@ -180,6 +182,9 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
                                                       quote_value(p.motion_algo) + "'");
   if (p.config_learns_from == ConfigLearnsFrom::greedy && p.greedy_motion_interval < 1)
     fail(source, pre + ".config_learns_from", "greedy needs trainer.greedy_motion_interval >= 1");
+  if (p.decision_image_first_only && !p.config_vector)
+    fail(source, pre + ".decision_image_first_only",
+         "needs trainer.config_vector true (a later decision would see nothing but a blank image)");
   if (p.config_target_distance && !p.config_vector)
     fail(source, pre + ".config_target_distance", "needs trainer.config_vector true (the distance follows its values)");
   if (!p.refit_motion_from.empty()) {

@@ -105,6 +105,11 @@ struct TrainerParams {
   // show it. The distance says nothing of the stair height or the obstacles.
   bool config_target_distance = false;
   bool decision_camera = false;       // the DQN sees the decision camera (env.robot.decision_*), not the motion camera
+  // The DQN sees its image only at the episode's first decision; later ones
+  // (after a scene switch) see a blank image, so that choice rests on
+  // config_vector's chain and scene. What the camera shows while the robot
+  // drives changes from step to step, and a choice that followed it flickered.
+  bool decision_image_first_only = false;
   // Who drives the motion during the warm-up: "random" (uniform actions, the
   // paper) or "scripted" (task::ScriptedPilot, which plans on the true obstacle
   // layout, plus Gaussian noise): demonstrations in the replay, marked as such.

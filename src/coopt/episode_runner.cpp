@@ -167,8 +167,12 @@ void fill_motion(const task::MultiTaskEnv& env, const TrainerParams& t, rl::Obse
   fill_motion(env.depth(), env.state(), env.clearance(), t, o);
 }
 
-void fill_config(const task::MultiTaskEnv& env, const TrainerParams& t, int scene, Buffers& b, rl::Observation& o) {
-  if (t.decision_camera)
+// `first`: the episode's first decision (trainer.decision_image_first_only blanks the others' image).
+void fill_config(const task::MultiTaskEnv& env, const TrainerParams& t, int scene, bool first, Buffers& b,
+                 rl::Observation& o) {
+  if (t.decision_image_first_only && !first)
+    std::fill(o.image.begin(), o.image.end(), 0.0f);
+  else if (t.decision_camera)
     env.render_decision_depth(o.image.data());
   else
     std::copy(env.depth(), env.depth() + o.image.size(), o.image.begin());
@@ -244,7 +248,7 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
     lap(kEnvReset);
     scene.reset(env);
     lap(kClassifier);
-    fill_config(env, t, scene.current(), b, b.cobs);
+    fill_config(env, t, scene.current(), true, b, b.cobs);
     configuration = choose(b.cobs);
     lap(kDqn);
   }
@@ -309,7 +313,7 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
     //    new decision among [2, C_n].
     const double r2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
     return_r2 += r2;
-    fill_config(env, t, scene.current(), b, b.cnext);
+    fill_config(env, t, scene.current(), false, b, b.cnext);
     if (hooks)
       hooks->config(b.cobs, b.caction, learned_r2(hooks, segment, env, r2), b.cnext, false, false, segment.steps());
     std::swap(b.cobs, b.cnext);
@@ -330,7 +334,7 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
   if (hierarchical) {
     const double r2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
     return_r2 += r2;
-    fill_config(env, t, scene.current(), b, b.cnext);
+    fill_config(env, t, scene.current(), false, b, b.cnext);
     if (hooks)
       hooks->config(b.cobs, b.caction, learned_r2(hooks, segment, env, r2), b.cnext, r->terminated, r->truncated,
                     segment.steps());
