@@ -160,23 +160,22 @@ void fill_config_vector(const TrainerParams& t, const Configuration& current, in
   o.valid_actions = mask;
 }
 
-namespace {
-
-
-void fill_motion(const task::MultiTaskEnv& env, const TrainerParams& t, rl::Observation& o) {
-  fill_motion(env.depth(), env.state(), env.clearance(), t, o);
-}
-
-// `first`: the episode's first decision (trainer.decision_image_first_only blanks the others' image).
-void fill_config(const task::MultiTaskEnv& env, const TrainerParams& t, int scene, bool first, Buffers& b,
-                 rl::Observation& o) {
+void fill_config(const task::MultiTaskEnv& env, const TrainerParams& t, int scene, bool first,
+                 std::vector<std::uint8_t>& mask, rl::Observation& o) {
   if (t.decision_image_first_only && !first)
     std::fill(o.image.begin(), o.image.end(), 0.0f);
   else if (t.decision_camera)
     env.render_decision_depth(o.image.data());
   else
     std::copy(env.depth(), env.depth() + o.image.size(), o.image.begin());
-  fill_config_vector(t, env.configuration(), scene, env.target_distance(), b.mask, o);
+  fill_config_vector(t, env.configuration(), scene, env.target_distance(), mask, o);
+}
+
+namespace {
+
+
+void fill_motion(const task::MultiTaskEnv& env, const TrainerParams& t, rl::Observation& o) {
+  fill_motion(env.depth(), env.state(), env.clearance(), t, o);
 }
 
 control::MotionMode mode_of(int scene) {
@@ -248,7 +247,7 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
     lap(kEnvReset);
     scene.reset(env);
     lap(kClassifier);
-    fill_config(env, t, scene.current(), true, b, b.cobs);
+    fill_config(env, t, scene.current(), true, b.mask, b.cobs);
     configuration = choose(b.cobs);
     lap(kDqn);
   }
@@ -313,7 +312,7 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
     //    new decision among [2, C_n].
     const double r2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
     return_r2 += r2;
-    fill_config(env, t, scene.current(), false, b, b.cnext);
+    fill_config(env, t, scene.current(), false, b.mask, b.cnext);
     if (hooks)
       hooks->config(b.cobs, b.caction, learned_r2(hooks, segment, env, r2), b.cnext, false, false, segment.steps());
     std::swap(b.cobs, b.cnext);
@@ -334,7 +333,7 @@ EpisodeLog EpisodeRunner::play(Agent& agent, task::EpisodeSpec spec, bool explor
   if (hierarchical) {
     const double r2 = segment.r2(c.env.task.r2, env.stair_height(), env.stairs_energy());
     return_r2 += r2;
-    fill_config(env, t, scene.current(), false, b, b.cnext);
+    fill_config(env, t, scene.current(), false, b.mask, b.cnext);
     if (hooks)
       hooks->config(b.cobs, b.caction, learned_r2(hooks, segment, env, r2), b.cnext, r->terminated, r->truncated,
                     segment.steps());

@@ -76,6 +76,12 @@ void fill_motion(const float* depth, const float* state, const float* clearance,
 // modules to; `mask` is its storage); the image is already in o.image.
 void fill_config_vector(const TrainerParams& t, const Configuration& current, int scene, double target_distance_m,
                         std::vector<std::uint8_t>& mask, rl::Observation& o);
+// The configuration model's whole observation of `env`: its image (the
+// decision camera's with trainer.decision_camera, else depth(); blank at every
+// decision but the episode's `first` with trainer.decision_image_first_only),
+// then fill_config_vector's.
+void fill_config(const task::MultiTaskEnv& env, const TrainerParams& t, int scene, bool first,
+                 std::vector<std::uint8_t>& mask, rl::Observation& o);
 
 // The scene spec of evaluation episode i (heights cycle 0.04, 0.06, 0.08).
 task::EpisodeSpec eval_spec(const CooptConfig& c, const task::ScenarioSpec& scenario, std::uint64_t seed, int i);

@@ -351,6 +351,36 @@ TEST(ConfigVector, TargetDistanceFollowsTheChainLengthAndTheScene) {
   EXPECT_EQ(o.vector.size(), 4u);
 }
 
+// trainer.decision_image_first_only: the first decision sees the decision
+// camera, every later one a blank image beside the same vector; without it
+// the later decisions see the camera too. An image without the vector is refused.
+TEST(ConfigVector, DecisionImageFirstOnlyBlanksTheLaterDecisionsImage) {
+  const auto image_sum = [](bool first_only, bool first) {
+    const CooptConfig c = load_coopt_config(
+        kCi, {"trainer.decision_camera=true", std::string("trainer.decision_image_first_only=") + (first_only ? "true" : "false")});
+    task::MultiTaskEnv env(c.env);
+    task::EpisodeSpec spec = eval_spec(c, task::scenario_named("default"), 5150, 2);
+    spec.configuration = make_chain(6);
+    env.reset(spec);
+    rl::Observation o;
+    rl::allocate(config_spec(c), o);
+    std::fill(o.image.begin(), o.image.end(), 0.5f);  // what a previous decision left
+    std::vector<std::uint8_t> mask;
+    fill_config(env, c.trainer, 1, first, mask, o);
+    EXPECT_FLOAT_EQ(o.vector[0], 0.6f);  // C_n / 10 in every case
+    EXPECT_FLOAT_EQ(o.vector[2], 1.0f);  // scene 1
+    double sum = 0;
+    for (float v : o.image) sum += std::abs(v);
+    return sum;
+  };
+  const double first = image_sum(true, true);
+  EXPECT_GT(first, 0.0);
+  EXPECT_EQ(image_sum(true, false), 0.0);
+  EXPECT_DOUBLE_EQ(image_sum(false, false), first);  // the same env, the same camera
+  expect_error({"trainer.decision_image_first_only=true", "trainer.config_vector=false"},
+               "trainer.decision_image_first_only");
+}
+
 // dqn_refit: holds only the keys in which the refit DQN differs from dqn:.
 TEST(CooptConfig, DqnRefitOverlaysTheDqnSection) {
   const CooptConfig plain = load_coopt_config(kCi, {"trainer.config_refit_episodes=2"});
