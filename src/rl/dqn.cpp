@@ -80,7 +80,8 @@ torch::Tensor Dqn::td_target(const ReplayBatch& b) {
   // targets) bootstraps nothing: the target network's forward pass, about a
   // quarter of an update, is skipped. The same numbers: the bootstrap term
   // would be 0 times a finite value.
-  if (!b.bootstrap.any().item<bool>()) return b.reward.clone();
+  const torch::Tensor reward = config_.reward_scale == 1.0 ? b.reward : b.reward * config_.reward_scale;
+  if (!b.bootstrap.any().item<bool>()) return reward.clone();
   {
     const torch::Tensor valid = b.next_valid_actions;
     const torch::Tensor q_next = q_target_->forward(b.next_image, b.next_vector);
@@ -94,7 +95,7 @@ torch::Tensor Dqn::td_target(const ReplayBatch& b) {
     }
     // A next state without valid actions (terminal) has value 0, not -inf.
     next_value = torch::where(valid.any(1), next_value, torch::zeros_like(next_value));
-    return b.reward + b.bootstrap * next_value;
+    return reward + b.bootstrap * next_value;
   }
 }
 

@@ -38,7 +38,7 @@ class Dqn final : public OffPolicyLearner {
   // TD targets r + bootstrap * max over the next state's valid actions of
   // Q_target(s', a) (Double DQN: Q_target at the online net's valid argmax).
   torch::Tensor td_target(const ReplayBatch& batch);
-  // Q values of one observation (greedy diagnostics, tests).
+  // Q values of one observation (greedy diagnostics, tests), in units of reward x config().reward_scale.
   std::vector<float> q_values(const Observation& observation);
   const DqnConfig& config() const { return config_; }
   QNetwork& target_network() { return q_target_; }

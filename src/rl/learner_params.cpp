@@ -51,6 +51,8 @@ void add_fields(YamlFields& f, DqnConfig& c) {
   f.add("double_dqn", &c.double_dqn, "pick the next action with the online network (double DQN)");
   f.add("ensemble_size", &c.ensemble_size, 1, 64,
         "Q networks trained on the same batches from their own initial weights; acting and targets use their mean");
+  f.add("reward_scale", &c.reward_scale, 1e-9, 1e9,
+        "the networks learn Q in units of reward x this (the greedy choice is unchanged); < 1 for returns of hundreds");
 }
 
 void add_fields(YamlFields& f, Td3Config& c) {

@@ -108,6 +108,12 @@ struct DqnConfig {
   // what each member fits of one image's noisy return (docs/results.md: it
   // steadied the refit's shed choice, but did not raise success).
   int ensemble_size = 1;
+  // The networks learn Q in units of reward x this (targets scale r + gamma Q'
+  // alike, so the greedy choice is the same). Returns of hundreds, as the
+  // co-optimization's R2, need weights far from their initial scale: at Adam's
+  // usual step sizes the network then fits one value per action and ignores
+  // the small inputs (docs/results.md, "The refit DQN under-fits").
+  double reward_scale = 1.0;
   std::vector<int> hidden_sizes{120, 84};  // MLP head; [] + image-only obs = paper's net
   int image_features = 256;             // CNN output size when an MLP head follows
   int image_fc_size = 256;              // the CNN's hidden FC layer

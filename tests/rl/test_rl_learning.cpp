@@ -232,8 +232,10 @@ TEST(Learning, DqnLearnsCorridorValues) {
 // prefers the sure one. The configuration model's returns (hundreds, with
 // stalls on the stairs among them) are in this regime (configs/standard.yaml).
 namespace {
-// A DQN (small_dqn + `extra`) trained on 3000 alternating tries of the two chains.
-std::unique_ptr<rl::Learner> dqn_on_risky_and_sure_chains(const rl::Observation& o, const YAML::Node& extra) {
+// A DQN (small_dqn + `extra`) trained on 3000 alternating tries of the two
+// chains, whose returns are multiplied by `payout`.
+std::unique_ptr<rl::Learner> dqn_on_risky_and_sure_chains(const rl::Observation& o, const YAML::Node& extra,
+                                                          float payout = 1.0f) {
   YAML::Node config = small_dqn();
   config["train_frequency"] = 1;
   for (const auto& kv : extra) config[kv.first.Scalar()] = kv.second;
@@ -244,7 +246,7 @@ std::unique_ptr<rl::Learner> dqn_on_risky_and_sure_chains(const rl::Observation&
   rl::Action a;
   for (int i = 0; i < 3000; ++i) {
     a.discrete = i % 2;
-    const float r = a.discrete == 0 ? (risky_pays(rng) ? 10.0f : 0.0f) : 9.0f;
+    const float r = payout * (a.discrete == 0 ? (risky_pays(rng) ? 10.0f : 0.0f) : 9.0f);
     learner->store(o, a, r, o, /*terminated=*/true, false);
     for (int u = learner->updates_due(); u > 0; --u) learner->update();
   }
@@ -290,6 +292,29 @@ TEST(Learning, DqnEnsembleMembersEachLearnTheMeanReturns) {
     EXPECT_NEAR(members[m][0][0].item<float>(), 7.0, 1.0) << "member " << m;
     EXPECT_NEAR(members[m][0][1].item<float>(), 9.0, 0.7) << "member " << m;
   }
+  const std::vector<float> q = dqn.q_values(o);
+  EXPECT_NEAR(q[0], 7.0, 0.8);
+  EXPECT_NEAR(q[1], 9.0, 0.5);
+  rl::Action greedy;
+  dqn.act(o, /*explore=*/false, greedy);
+  EXPECT_EQ(greedy.discrete, 1);
+}
+
+// The same bandit paying 100 times as much (returns of hundreds, as R2's):
+// in the same number of updates the network reaches nowhere near such values;
+// with dqn.reward_scale 0.01 it learns the means in units of 100 and prefers
+// the sure chain again.
+TEST(Learning, DqnRewardScaleLetsItFitReturnsOfHundreds) {
+  rl::Observation o;
+  o.vector = {1.0f};
+  YAML::Node extra;
+  extra["loss"] = "mse";
+  const std::vector<float> unscaled =
+      static_cast<rl::Dqn&>(*dqn_on_risky_and_sure_chains(o, extra, 100.0f)).q_values(o);
+  EXPECT_LT(unscaled[1], 700.0) << "the sure chain's mean is 900";
+  extra["reward_scale"] = 0.01;
+  auto learner = dqn_on_risky_and_sure_chains(o, extra, 100.0f);
+  auto& dqn = static_cast<rl::Dqn&>(*learner);
   const std::vector<float> q = dqn.q_values(o);
   EXPECT_NEAR(q[0], 7.0, 0.8);
   EXPECT_NEAR(q[1], 9.0, 0.5);
