@@ -252,6 +252,16 @@ std::unique_ptr<rl::Learner> dqn_on_risky_and_sure_chains(const rl::Observation&
   }
   return learner;
 }
+
+// Q near the means (7 and 9, in units of the payout) and the greedy choice the sure chain.
+void expect_the_means_and_the_sure_chain(rl::Dqn& dqn, const rl::Observation& o) {
+  const std::vector<float> q = dqn.q_values(o);
+  EXPECT_NEAR(q[0], 7.0, 0.8);
+  EXPECT_NEAR(q[1], 9.0, 0.5);
+  rl::Action greedy;
+  dqn.act(o, /*explore=*/false, greedy);
+  EXPECT_EQ(greedy.discrete, 1);
+}
 }  // namespace
 
 TEST(Learning, DqnMseLearnsMeanReturnsWhereHuberLearnsMedians) {
@@ -261,11 +271,10 @@ TEST(Learning, DqnMseLearnsMeanReturnsWhereHuberLearnsMedians) {
     YAML::Node extra;
     extra["loss"] = loss;
     auto learner = dqn_on_risky_and_sure_chains(o, extra);
-    const std::vector<float> q = static_cast<rl::Dqn&>(*learner).q_values(o);
+    auto& dqn = static_cast<rl::Dqn&>(*learner);
+    const std::vector<float> q = dqn.q_values(o);
     if (std::string(loss) == "mse") {
-      EXPECT_NEAR(q[0], 7.0, 0.8);
-      EXPECT_NEAR(q[1], 9.0, 0.5);
-      EXPECT_LT(q[0], q[1]);
+      expect_the_means_and_the_sure_chain(dqn, o);
     } else {
       EXPECT_GT(q[0], 9.3) << "Huber: the risky chain's median, 10";
       EXPECT_GT(q[0], q[1]);
@@ -292,12 +301,7 @@ TEST(Learning, DqnEnsembleMembersEachLearnTheMeanReturns) {
     EXPECT_NEAR(members[m][0][0].item<float>(), 7.0, 1.0) << "member " << m;
     EXPECT_NEAR(members[m][0][1].item<float>(), 9.0, 0.7) << "member " << m;
   }
-  const std::vector<float> q = dqn.q_values(o);
-  EXPECT_NEAR(q[0], 7.0, 0.8);
-  EXPECT_NEAR(q[1], 9.0, 0.5);
-  rl::Action greedy;
-  dqn.act(o, /*explore=*/false, greedy);
-  EXPECT_EQ(greedy.discrete, 1);
+  expect_the_means_and_the_sure_chain(dqn, o);
 }
 
 // The same bandit paying 100 times as much (returns of hundreds, as R2's):
@@ -315,12 +319,7 @@ TEST(Learning, DqnRewardScaleLetsItFitReturnsOfHundreds) {
   extra["reward_scale"] = 0.01;
   auto learner = dqn_on_risky_and_sure_chains(o, extra, 100.0f);
   auto& dqn = static_cast<rl::Dqn&>(*learner);
-  const std::vector<float> q = dqn.q_values(o);
-  EXPECT_NEAR(q[0], 7.0, 0.8);
-  EXPECT_NEAR(q[1], 9.0, 0.5);
-  rl::Action greedy;
-  dqn.act(o, /*explore=*/false, greedy);
-  EXPECT_EQ(greedy.discrete, 1);
+  expect_the_means_and_the_sure_chain(dqn, o);
 }
 
 TEST(Learning, Td3DrivesPointToOrigin) {
