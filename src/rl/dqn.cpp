@@ -80,8 +80,8 @@ torch::Tensor Dqn::td_target(const ReplayBatch& b) {
   // targets) bootstraps nothing: the target network's forward pass, about a
   // quarter of an update, is skipped. The same numbers: the bootstrap term
   // would be 0 times a finite value.
-  const torch::Tensor reward = config_.reward_scale == 1.0 ? b.reward : b.reward * config_.reward_scale;
-  if (!b.bootstrap.any().item<bool>()) return reward.clone();
+  const torch::Tensor reward = b.reward * config_.reward_scale;  // a new tensor; x 1.0 is exact
+  if (!b.bootstrap.any().item<bool>()) return reward;
   {
     const torch::Tensor valid = b.next_valid_actions;
     const torch::Tensor q_next = q_target_->forward(b.next_image, b.next_vector);
