@@ -62,7 +62,7 @@ Dqn::Dqn(const ObservationSpec& observation, int num_actions, const DqnConfig& c
     : OffPolicyLearner("dqn", "q", observation, {ActionKind::kDiscrete, num_actions}, config, seed),
       num_actions_(num_actions), config_(config) {
   build_networks(seed, q_, q_target_, [&] { return make_network(spec_, num_actions, config); });
-  optimizer_ = make_adam(q_->parameters(), config.learning_rate, config.adam_epsilon);
+  optimizer_ = make_adam(q_->parameters(), config.learning_rate, config.adam_epsilon, config.weight_decay);
   target_ = FlatParameters(q_target_->parameters(), /*with_grad=*/false);
 }
 

@@ -78,6 +78,7 @@ void FlatAdam::step() {
   const double bias_correction1 = 1 - std::pow(options_.beta1, static_cast<double>(steps_));
   const double bias_correction2 = 1 - std::pow(options_.beta2, static_cast<double>(steps_));
   const torch::Tensor& g = parameters_.grad();
+  const double decay = 1 - options_.learning_rate * options_.weight_decay;
   if (is_plain_cpu_float(g) && is_plain_cpu_float(parameters_.data())) {
     const float* grad = g.data_ptr<float>();
     float* p = parameters_.data().data_ptr<float>();
@@ -88,6 +89,10 @@ void FlatAdam::step() {
     const auto inverse_sqrt_bc2 = static_cast<float>(1.0 / std::sqrt(bias_correction2));
     const auto epsilon = static_cast<float>(options_.epsilon);
     const std::int64_t n = g.numel();
+    if (options_.weight_decay > 0) {
+      const auto f = static_cast<float>(decay);
+      for (std::int64_t i = 0; i < n; ++i) p[i] *= f;
+    }
     for (std::int64_t i = 0; i < n; ++i) {
       m[i] = b1 * m[i] + (1.0f - b1) * grad[i];
       v[i] = b2 * v[i] + (1.0f - b2) * grad[i] * grad[i];
@@ -95,6 +100,7 @@ void FlatAdam::step() {
     }
     return;
   }
+  if (options_.weight_decay > 0) parameters_.data().mul_(decay);
   exp_avg_.mul_(options_.beta1).add_(g, 1 - options_.beta1);
   exp_avg_sq_.mul_(options_.beta2).addcmul_(g, g, 1 - options_.beta2);
   torch::sqrt_out(denominator_, exp_avg_sq_);

@@ -54,8 +54,10 @@ class FlatParameters {
 // target <- (1 - tau) target + tau online, over whole buffers (same layout).
 void soft_update(FlatParameters& target, const FlatParameters& online, double tau);
 
-// Adam (Kingma & Ba 2015) as torch::optim::Adam computes it without weight
-// decay or AMSGrad, over one FlatParameters: one operation per term.
+// Adam (Kingma & Ba 2015) as torch::optim::Adam computes it without AMSGrad,
+// over one FlatParameters: one operation per term. weight_decay > 0 makes it
+// AdamW (Loshchilov & Hutter 2019) as torch::optim::AdamW: every step first
+// shrinks the weights by the factor 1 - learning_rate x weight_decay.
 class FlatAdam {
  public:
   struct Options {
@@ -63,6 +65,7 @@ class FlatAdam {
     double beta1 = 0.9;
     double beta2 = 0.999;
     double epsilon = 1e-8;
+    double weight_decay = 0;  // decoupled (AdamW); 0 = plain Adam
   };
   FlatAdam(std::vector<torch::Tensor> parameters, Options options);
 

@@ -44,6 +44,8 @@ void add_fields(YamlFields& f, DqnConfig& c) {
         "the paper's Algorithm 1)");
   f.add("learning_rate", &c.learning_rate, kMinPositive, 1.0, "Adam step size");
   f.add("adam_epsilon", &c.adam_epsilon, 1e-20, 1.0, "Adam's epsilon");
+  f.add("weight_decay", &c.weight_decay, 0.0, 1000.0,
+        "decoupled weight decay (AdamW): each update shrinks the weights by 1 - learning_rate x this; 0 = Adam");
   f.add("target_update_interval", &c.target_update_interval, 1, 1000000000, "updates between target syncs");
   add_linear_schedule(f, "epsilon", c.epsilon_start, c.epsilon_end, c.epsilon_decay, 1.0,
                       "probability of a random choice", "stored transitions");

@@ -90,6 +90,12 @@ struct DqnConfig {
   DiscountPer discount_per = DiscountPer::step;
   double learning_rate = 2.5e-4;        // Adam step size
   double adam_epsilon = 1e-8;           // Adam's epsilon
+  // Decoupled weight decay (AdamW): each update first shrinks the weights by
+  // 1 - learning_rate x this. Thousands of updates on a replay of a few
+  // thousand noisy returns let the CNN fit each image's own luck: held-out
+  // images of one stair height then scatter over several choices
+  // (docs/results.md, "The refit DQN memorises its images"). 0 = plain Adam.
+  double weight_decay = 0;
   int batch_size = 128;                 // transitions per update
   std::int64_t buffer_size = 10000;     // replay capacity, transitions
   std::int64_t learning_starts = 10000; // transitions stored before the first update

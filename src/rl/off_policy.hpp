@@ -150,10 +150,11 @@ class OffPolicyLearner : public Learner {
   virtual torch::nn::Module& acting_module() const = 0;
   // Adam with this learner's options over `parameters`, kept flat (rl/flat_adam.hpp).
   static std::unique_ptr<FlatAdam> make_adam(std::vector<torch::Tensor> parameters, double learning_rate,
-                                             double epsilon = 1e-8) {
+                                             double epsilon = 1e-8, double weight_decay = 0) {
     FlatAdam::Options o;
     o.learning_rate = learning_rate;
     o.epsilon = epsilon;
+    o.weight_decay = weight_decay;
     return std::make_unique<FlatAdam>(std::move(parameters), o);
   }
   // The exponent k of a stored transition's discount gamma^k, for one that

@@ -371,6 +371,38 @@ TEST(FlatAdam, StepsAsTorchAdamWithClippingAndAfterAModuleLoad) {
   std::filesystem::remove(state_path);
 }
 
+// With weight_decay, FlatAdam steps as torch's AdamW (decoupled decay), and
+// the decay is real: the same steps without it leave larger weights.
+TEST(FlatAdam, WithWeightDecayStepsAsTorchAdamW) {
+  torch::manual_seed(5);
+  rl::Mlp reference(5, std::vector<int>{16}, 3), flat(5, std::vector<int>{16}, 3), plain(5, std::vector<int>{16}, 3);
+  rl::copy_parameters(*flat, *reference);
+  rl::copy_parameters(*plain, *reference);
+  torch::optim::AdamW torch_adamw(reference->parameters(), torch::optim::AdamWOptions(3e-3).weight_decay(5.0));
+  rl::FlatAdam flat_adamw(flat->parameters(), {3e-3, 0.9, 0.999, 1e-8, 5.0});
+  rl::FlatAdam flat_adam(plain->parameters(), {3e-3, 0.9, 0.999, 1e-8});
+  const auto norm = [](rl::Mlp& m) {
+    double s = 0;
+    for (const auto& p : m->parameters()) s += p.pow(2).sum().item<double>();
+    return std::sqrt(s);
+  };
+  for (int i = 0; i < 50; ++i) {
+    const torch::Tensor x = torch::randn({32, 5}), y = torch::randn({32, 3});
+    torch_adamw.zero_grad();
+    torch::mse_loss(reference->forward(x), y).backward();
+    torch_adamw.step();
+    flat_adamw.zero_grad();
+    torch::mse_loss(flat->forward(x), y).backward();
+    flat_adamw.step();
+    flat_adam.zero_grad();
+    torch::mse_loss(plain->forward(x), y).backward();
+    flat_adam.step();
+  }
+  const auto r = reference->parameters(), f = flat->parameters();
+  for (std::size_t i = 0; i < r.size(); ++i) EXPECT_TRUE(torch::allclose(r[i], f[i], 1e-5, 1e-6)) << "tensor " << i;
+  EXPECT_LT(norm(flat), 0.8 * norm(plain)) << "50 steps x 1.5 % decay each shrink the weights";
+}
+
 // ---- DQN masking and targets ------------------------------------------------------
 
 TEST(Dqn, ActsOnlyAmongValidActions) {
