@@ -158,6 +158,7 @@ void Actor::take(const ActingWeights& weights, const Orders& orders) {
   }
   if (orders.start) {
     stair_height_m_ = orders.stair_height_m;
+    first_config_ = orders.first_config;
     rng_ = orders.rng;
     agent_.motion->set_rng(orders.motion_rng);
   }
@@ -208,6 +209,7 @@ void Actor::play(int episode, ActorLink& link) {
   const TrainerParams& t = config_.trainer;
   EpisodePlan plan = plan_episode(t, episode);
   if (stair_height_m_ > 0) plan.spec.stair_height = stair_height_m_;
+  if (first_config_ >= 0) plan.first_config = first_config_;
   LearnHooks hooks;
   hooks.laps = &laps;
   hooks.motion = [this, &link, learning = !plan.refit](const rl::Observation& o, const rl::Action& a, float r,
@@ -388,7 +390,7 @@ template <class F, class W, class O>
 void release_fields(F& f, W& w, O& o) {
   f(w.motion_version), f(w.config_version), f(w.config_refit), f(w.config_counters);
   f(o.episode), f(o.start), f(o.rng), f(o.motion_rng), f(o.set_motion_counters), f(o.motion_counters);
-  f(o.set_config_rng), f(o.config_rng), f(o.stair_height_m);
+  f(o.set_config_rng), f(o.config_rng), f(o.stair_height_m), f(o.first_config);
 }
 
 }  // namespace

@@ -57,14 +57,15 @@ struct EpisodePlan {
   bool config_learns = false;  // the DQN learns from this episode's decisions
   bool random_config = false;  // configurations drawn uniformly (warm-up, pilot_random_configs, random_config_interval)
   bool pilot = false;          // the pilot plans: BC targets, and drives when scripted
-  int first_config = -1;       // the refit's sweep (refit_sweep_scenes): the first decision's candidate, else -1
+  int first_config = -1;       // the first decision's candidate (refit_sweep_scenes, chain_curriculum), else -1
   task::EpisodeSpec spec;      // the scene (seed from trainer.seed and the index)
 };
 EpisodePlan plan_episode(const TrainerParams& t, int episode);
 
 // The seed of random stream `stream` of training episode `episode` (several
 // actors: 0 the actor's RNG, 1 the motion policy's, 2 the DQN copy's; any
-// actor count: 3 the stair curriculum's height).
+// actor count: 3 the stair curriculum's height, 4 whether the chain curriculum
+// draws, 5 its pair).
 std::uint64_t stream_seed(int seed, int episode, int stream);
 // The first episode index after `from` before which every actor must have
 // ended its episode: a checkpoint, an evaluation, the refit's start, the end.
@@ -138,7 +139,8 @@ struct Orders {
   rl::LearnerCounters motion_counters;
   bool set_config_rng = false;  // the DQN copy's RNG
   std::mt19937_64 config_rng;
-  double stair_height_m = 0;  // with `start`: > 0 the episode's stair height (trainer.stair_curriculum)
+  double stair_height_m = 0;  // with `start`: > 0 the episode's stair height (trainer.stair/chain_curriculum)
+  int first_config = -1;      // with `start`: >= 0 the first decision's candidate (trainer.chain_curriculum)
 };
 
 // The values as bytes, for a transport between processes (coopt/actor_ranks.hpp).
@@ -209,6 +211,7 @@ class Actor {
   task::ScriptedPilot pilot_;
   std::mt19937_64 rng_;  // the episode's uniform configuration choices and pilot noise
   double stair_height_m_ = 0;  // > 0: the host's stair height for the episode
+  int first_config_ = -1;      // >= 0: the host's first decision for the episode
   task::R2Params training_r2_;  // the R2 the DQN learns from before the refit (trainer.config_energy_weight)
   Rollout rollout_;
   int interval_ = 0;    // one actor: motion transitions since the learner's last hand-over

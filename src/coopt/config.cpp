@@ -114,6 +114,11 @@ void add_fields(YamlFields& f, TrainerParams& p) {
         "recent failure rate at each height (the rest uniformly); 0 = none");
   f.add("stair_curriculum_window", &p.stair_curriculum_window, 1, kMaxEpisodes,
         "the last this-many training episodes at each height give its failure rate (stair_curriculum)");
+  f.add("chain_curriculum", &p.chain_curriculum, 0.0, 1.0,
+        "share of the training episodes after the warm-up that play a (stair height, first chain) pair drawn in "
+        "proportion to p (1 - p), p the pair's recent share of climbed stairs (the rest: the DQN's choice); 0 = none");
+  f.add("chain_curriculum_window", &p.chain_curriculum_window, 1, kMaxEpisodes,
+        "the last this-many training episodes of each (height, first chain) pair give its p (chain_curriculum)");
   f.add("config_energy_weight", &p.config_energy_weight, -1.0, 10.0,
         "per J; R2's energy weight sigma3 in the returns the DQN learns from before the refit; negative = "
         "env.task.r2.sigma3 (the refit, logs and F(H) keep the task's)");
@@ -204,6 +209,8 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
   if (p.stair_curriculum > 0 && p.stair_height > 0)
     fail(source, pre + ".stair_curriculum",
          "needs the stair heights drawn per episode (trainer.stair_height 0), not one height always");
+  if (p.chain_curriculum > 0 && p.mode != TrainerMode::hierarchical)
+    fail(source, pre + ".chain_curriculum", "needs trainer.mode hierarchical (a fixed chain has no first choice to draw)");
   if (p.config_refit_episodes > 0 && p.mode != TrainerMode::hierarchical)
     fail(source, pre + ".config_refit_episodes", "needs trainer.mode hierarchical (a fixed chain has no DQN)");
   // Whether the directory holds a classifier is checked where it is loaded

@@ -128,10 +128,19 @@ struct TrainerParams {
   // A share of the training episodes after the warm-up (0 = none) takes its
   // stair height in proportion to the run's recent failure rate at each
   // height, over its last stair_curriculum_window training episodes there
-  // (coopt/stair_curriculum.hpp); the rest keep the scene's uniform draw.
+  // (coopt/curriculum.hpp); the rest keep the scene's uniform draw.
   // More practice where the run fails, from its own outcomes only.
   double stair_curriculum = 0;
   int stair_curriculum_window = 50;
+  // A share of the training episodes after the warm-up (0 = none) plays a
+  // (stair height, first chain) pair drawn in proportion to p (1 - p), p the
+  // share of the pair's last chain_curriculum_window training episodes whose
+  // first chain climbed the stairs (coopt/curriculum.hpp): the motion model
+  // practises every chain where it is learning, not only the DQN's choice.
+  // Later decisions stay the DQN's. The rest keep the scene's (or the stair
+  // curriculum's) height and the DQN's first choice.
+  double chain_curriculum = 0;
+  int chain_curriculum_window = 20;
   // R2's energy weight (sigma3, per J of stair energy) in the returns the
   // configuration model learns from before the DQN refit; negative = the
   // task's (env.task.r2.sigma3). The refit, the logs and F(H) keep the task's.

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <random>
 
 #include "coopt/segment.hpp"
 #include "rl/learner.hpp"
@@ -18,9 +19,16 @@ void copy_transition(const Transition& from, Transition& to) {
   to.set(from.obs, from.action, from.reward, from.next, from.terminated, from.truncated, from.steps);
 }
 
-// The training episodes the stair curriculum draws heights for and learns from: after the warm-up, before the refit.
+bool training_episode(const TrainerParams& t, int episode) {
+  return episode >= t.warmup_episodes && episode < t.refit_start();
+}
+
+// The training episodes a curriculum draws for and learns from: after the warm-up, before the refit.
 bool curriculum_episode(const TrainerParams& t, int episode) {
-  return t.stair_curriculum > 0 && episode >= t.warmup_episodes && episode < t.refit_start();
+  return t.stair_curriculum > 0 && training_episode(t, episode);
+}
+bool chain_curriculum_episode(const TrainerParams& t, int episode) {
+  return t.chain_curriculum > 0 && training_episode(t, episode);
 }
 
 }  // namespace
@@ -105,6 +113,14 @@ Orders LearnerHost::start_orders(int episode) const {
   const TrainerParams& t = config_.trainer;
   if (curriculum_episode(t, episode))
     o.stair_height_m = state_.curriculum.draw(height_weights_, stream_seed(t.seed, episode, 3));
+  if (chain_curriculum_episode(t, episode)) {
+    std::mt19937_64 share(stream_seed(t.seed, episode, 4));
+    if (std::uniform_real_distribution<double>(0.0, 1.0)(share) < t.chain_curriculum) {
+      const ChainCurriculum::Pair pair = state_.chain_curriculum.draw(pair_weights_, stream_seed(t.seed, episode, 5));
+      o.stair_height_m = pair.height_m;
+      o.first_config = candidate_of(pair.modules);
+    }
+  }
   return o;
 }
 
@@ -120,6 +136,7 @@ void LearnerHost::begin_block() {
   next_ = state_.episode;
   // Fixed for the block: every actor count draws from the same probabilities.
   if (t.stair_curriculum > 0) height_weights_ = state_.curriculum.weights(t.stair_curriculum);
+  if (t.chain_curriculum > 0) pair_weights_ = state_.chain_curriculum.weights();
   refresh_motion();
   refresh_config();
   active_ = 0;
@@ -321,6 +338,8 @@ void LearnerHost::take_motion_model(const std::string& run_dir) {
 void LearnerHost::log_episode(const EpisodeLog& log) {
   const TrainerParams& t = config_.trainer;
   if (curriculum_episode(t, log.episode)) state_.curriculum.record(log.stair_height_m, log.success);
+  if (chain_curriculum_episode(t, log.episode) && !log.configurations.empty())
+    state_.chain_curriculum.record(log.stair_height_m, log.configurations.front(), log.stairs_climbed);
   store_.append_episode(log);
   if (callbacks_.on_episode) callbacks_.on_episode(log);
   progress(log);

@@ -93,6 +93,7 @@ class LearnerHost {
   std::int64_t motion_updates_ = -1, config_updates_ = -1;  // the learners' updates at the last refresh
   std::vector<Orders> orders_;
   std::vector<double> height_weights_;  // the block's stair-height probabilities (trainer.stair_curriculum)
+  std::vector<double> pair_weights_;    // ... and (height, first chain) probabilities (trainer.chain_curriculum)
   int next_ = 0, end_ = 0, active_ = 0;  // the block's next index, its end, actors with an episode
   std::map<int, EpisodeLog> ended_;      // episodes that ended before an earlier one: rows go in index order
 

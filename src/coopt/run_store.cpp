@@ -350,6 +350,7 @@ void RunStore::write_checkpoint_files(const TrainingState& s, const CooptConfig&
   e << YAML::Key << "wall_s" << YAML::Value << wall_s;
   e << YAML::Key << "rng" << YAML::Value << rl::rng_state(s.rng);
   e << YAML::Key << "stair_curriculum" << YAML::Value << s.curriculum.outcomes_text();
+  e << YAML::Key << "chain_curriculum" << YAML::Value << s.chain_curriculum.outcomes_text();
   // env_files ends with a newline, which a literal block keeps; config has
   // none, which only the last value of the document keeps.
   e << YAML::Key << "env_files" << YAML::Value << YAML::Literal << config.env_text;
@@ -379,14 +380,17 @@ void RunStore::load_checkpoint(TrainingState& s, const CooptConfig& config) cons
   }
   const YAML::Node n = load_yaml_file((fs::path(info.directory) / "trainer.yaml").string());
   rl::set_rng_state(s.rng, n["rng"].as<std::string>());
-  // Checkpoints without it were written before the curriculum existed: it had no outcomes.
-  if (n["stair_curriculum"]) {
+  // Checkpoints without one were written before that curriculum existed: it had no outcomes.
+  auto outcomes = [&](const char* key, auto& curriculum) {
+    if (!n[key]) return;
     try {
-      s.curriculum.set_outcomes_text(n["stair_curriculum"].as<std::string>());
+      curriculum.set_outcomes_text(n[key].as<std::string>());
     } catch (const std::exception& e) {
-      throw std::runtime_error(info.directory + "/trainer.yaml: stair_curriculum: " + e.what() + "; refusing to resume");
+      throw std::runtime_error(info.directory + "/trainer.yaml: " + key + ": " + e.what() + "; refusing to resume");
     }
-  }
+  };
+  outcomes("stair_curriculum", s.curriculum);
+  outcomes("chain_curriculum", s.chain_curriculum);
   s.episode = info.episodes;
   s.evaluations = info.evaluations;
   s.steps = info.env_steps;

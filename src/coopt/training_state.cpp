@@ -61,7 +61,8 @@ std::unique_ptr<rl::Learner> make_refit_config_model(const CooptConfig& c) {
 }
 
 TrainingState::TrainingState(const CooptConfig& c)
-    : rng(c.trainer.seed * 7919ULL + 17), curriculum(stair_heights(c), c.trainer.stair_curriculum_window) {
+    : rng(c.trainer.seed * 7919ULL + 17), curriculum(stair_heights(c), c.trainer.stair_curriculum_window),
+      chain_curriculum(stair_heights(c), kMinModules, kMaxModules, c.trainer.chain_curriculum_window) {
   rl::set_torch_threads(c.trainer.torch_threads, 1);  // before the models: they run on these threads
   const std::uint64_t seed = static_cast<std::uint64_t>(c.trainer.seed);
   motion = make_motion_learner(c, seed);

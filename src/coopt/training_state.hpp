@@ -11,7 +11,7 @@
 
 #include "coopt/config.hpp"
 #include "coopt/episode_runner.hpp"
-#include "coopt/stair_curriculum.hpp"
+#include "coopt/curriculum.hpp"
 #include "rl/replay_segments.hpp"
 
 namespace comorph::coopt {
@@ -40,6 +40,7 @@ struct TrainingState {
   std::int64_t steps = 0;               // training control steps
   double wall_before = 0;               // training wall time of the earlier sessions (resume), s
   StairCurriculum curriculum;           // the training episodes' recent outcomes per stair height
+  ChainCurriculum chain_curriculum;     // ... and per (stair height, first chain) pair
   // The replay segments of the last checkpoint written or loaded: the next
   // checkpoint links those and writes only what was added since.
   rl::ReplaySegments motion_segments, config_segments;

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,7 @@
 #include "coopt/config.hpp"
 #include "coopt/episode_runner.hpp"
 #include "coopt/segment.hpp"
-#include "coopt/stair_curriculum.hpp"
+#include "coopt/curriculum.hpp"
 #include "coopt/trainer.hpp"
 #include "perception/params.hpp"
 #include "perception/scene_classifier.hpp"
@@ -435,6 +436,36 @@ TEST(Trainer, StairCurriculumDrawsTrainingHeightsFromTheRunsOutcomesAndResumesTo
   EXPECT_THROW(load_coopt_config(kCi, {"trainer.stair_curriculum=0.5", "trainer.stair_height=0.06"}),
                std::runtime_error);
   for (const std::string& d : {plain_dir, full_dir, dir, threads_a, threads_b}) fs::remove_all(d);
+}
+
+// trainer.chain_curriculum: every training episode after the warm-up plays
+// the (height, first chain) pair its own streams draw from the run's climbs
+// so far; later decisions stay the DQN's; the warm-up and the refit are
+// untouched; the outcomes go into the checkpoint.
+TEST(Trainer, ChainCurriculumDrawsTheFirstChainAndHeightFromTheRunsClimbs) {
+  const std::vector<std::string> sets{"trainer.episodes=6", "trainer.checkpoint_interval=3",
+                                      "trainer.config_refit_episodes=2", "trainer.chain_curriculum=1"};
+  const std::string dir = temp_dir("chain_curriculum");
+  const RunResult run = run_ci(sets, dir);
+  const CooptConfig c = load_coopt_config(kCi, sets);
+  const TrainerParams& t = c.trainer;
+  ASSERT_EQ(run.logs.size(), 10u);
+  ChainCurriculum replay(stair_heights(c), kMinModules, kMaxModules, t.chain_curriculum_window);
+  std::set<int> firsts;
+  for (int e = t.warmup_episodes; e < t.refit_start(); ++e) {
+    const EpisodeLog& l = run.logs[static_cast<std::size_t>(e)];
+    const ChainCurriculum::Pair p = replay.draw(replay.weights(), stream_seed(t.seed, e, 5));
+    EXPECT_EQ(l.stair_height_m, p.height_m) << "episode " << e;
+    ASSERT_FALSE(l.configurations.empty());
+    EXPECT_EQ(l.configurations.front(), p.modules) << "episode " << e;
+    firsts.insert(l.configurations.front());
+    replay.record(l.stair_height_m, l.configurations.front(), l.stairs_climbed);
+  }
+  EXPECT_GT(firsts.size(), 1u) << "the draws are not one chain";
+  const YAML::Node checkpoint = YAML::LoadFile(dir + "/checkpoint/trainer.yaml");
+  EXPECT_EQ(checkpoint["chain_curriculum"].as<std::string>(), replay.outcomes_text());
+  EXPECT_THROW(load_coopt_config(kCi, {"trainer.chain_curriculum=0.5", "trainer.mode=fixed"}), std::runtime_error);
+  fs::remove_all(dir);
 }
 
 // trainer.config_energy_weight: before the refit the DQN is paid R2 with that

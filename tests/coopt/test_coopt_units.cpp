@@ -14,7 +14,7 @@
 #include "coopt/config_reference.hpp"
 #include "coopt/episode_runner.hpp"
 #include "coopt/segment.hpp"
-#include "coopt/stair_curriculum.hpp"
+#include "coopt/curriculum.hpp"
 #include "coopt/training_state.hpp"
 #include "report/run_dir.hpp"
 #include "support/test_support.hpp"
@@ -137,6 +137,51 @@ TEST(StairCurriculum, DrawsHeightsInProportionToTheirRecentFailures) {
   EXPECT_THROW(back.set_outcomes_text("11,11"), std::runtime_error);
   EXPECT_THROW(back.set_outcomes_text("11,1x,1"), std::runtime_error);
   EXPECT_THROW(back.set_outcomes_text("11111,1,1"), std::runtime_error);
+}
+
+// trainer.chain_curriculum's draw: every (height, first chain) pair alike
+// until played, then in proportion to p (1 - p) of its recent climbs, with a
+// floor where the run always or never climbs.
+TEST(ChainCurriculum, DrawsThePairsWhoseClimbIsLeastCertain) {
+  ChainCurriculum c({0.04, 0.08}, 2, 4, 4);  // pairs: (0.04, 2), (0.04, 3), (0.04, 4), (0.08, 2), ...
+  ASSERT_EQ(c.pairs(), 6u);
+  for (const double w : c.weights()) EXPECT_NEAR(w, 1.0 / 6, 1e-12);
+  for (int i = 0; i < 4; ++i) {
+    c.record(0.04, 2, true);        // always: the floor
+    c.record(0.08, 2, false);       // never: the floor
+    c.record(0.079, 4, i % 2 == 0);  // half the time (the nearest height): the most
+  }
+  c.record(0.04, 3, true);  // 1 of 1: certain so far
+  EXPECT_EQ(c.climb_rates(), (std::vector<double>{1.0, 1.0, -1.0, 0.0, -1.0, 0.5}));
+  // Not played yet counts as half the time.
+  const double k = ChainCurriculum::kFloor, total = 2 * k + k + 0.25 + 0.25 + 0.25;
+  const std::vector<double> w = c.weights();
+  EXPECT_NEAR(w[0], k / total, 1e-12);
+  EXPECT_NEAR(w[1], k / total, 1e-12);
+  EXPECT_NEAR(w[2], 0.25 / total, 1e-12);
+  EXPECT_NEAR(w[3], k / total, 1e-12);
+  EXPECT_NEAR(w[5], 0.25 / total, 1e-12);
+  const ChainCurriculum::Pair first = c.pair_at(w, 0.0), last = c.pair_at(w, 0.999999);
+  EXPECT_EQ(first.height_m, 0.04);
+  EXPECT_EQ(first.modules, 2);
+  EXPECT_EQ(last.height_m, 0.08);
+  EXPECT_EQ(last.modules, 4);
+  EXPECT_THROW(c.record(0.04, 5, true), std::invalid_argument);
+
+  // Draws from independent streams follow the weights.
+  int drawn[6] = {0, 0, 0, 0, 0, 0};
+  const int n = 6000;
+  for (int e = 0; e < n; ++e) {
+    const ChainCurriculum::Pair p = c.draw(w, stream_seed(1, e, 5));
+    drawn[(p.height_m > 0.06 ? 3 : 0) + p.modules - 2] += 1;
+  }
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(drawn[i] / static_cast<double>(n), w[static_cast<std::size_t>(i)], 0.025) << i;
+
+  ChainCurriculum back({0.04, 0.08}, 2, 4, 4);
+  back.set_outcomes_text(c.outcomes_text());
+  EXPECT_EQ(back.climb_rates(), c.climb_rates());
+  EXPECT_EQ(back.outcomes_text(), "1111,1,,0000,,1010");
+  EXPECT_THROW(back.set_outcomes_text("1111,1,,0000,1010"), std::runtime_error);
 }
 
 TEST(Segment, DecisionReturnsSumTheLaterSegmentsDiscountedOncePerDecision) {
