@@ -88,15 +88,12 @@ void FlatAdam::step() {
     const auto step_size = static_cast<float>(options_.learning_rate / bias_correction1);
     const auto inverse_sqrt_bc2 = static_cast<float>(1.0 / std::sqrt(bias_correction2));
     const auto epsilon = static_cast<float>(options_.epsilon);
+    const auto shrink = static_cast<float>(decay);  // 1 without decay: p * 1 is p exactly
     const std::int64_t n = g.numel();
-    if (options_.weight_decay > 0) {
-      const auto f = static_cast<float>(decay);
-      for (std::int64_t i = 0; i < n; ++i) p[i] *= f;
-    }
     for (std::int64_t i = 0; i < n; ++i) {
       m[i] = b1 * m[i] + (1.0f - b1) * grad[i];
       v[i] = b2 * v[i] + (1.0f - b2) * grad[i] * grad[i];
-      p[i] -= step_size * m[i] / (std::sqrt(v[i]) * inverse_sqrt_bc2 + epsilon);
+      p[i] = shrink * p[i] - step_size * m[i] / (std::sqrt(v[i]) * inverse_sqrt_bc2 + epsilon);
     }
     return;
   }
