@@ -25,12 +25,12 @@ std::size_t index_at(const std::vector<double>& weights, double u) {
   return weights.size() - 1;  // u within rounding of 1
 }
 
+}  // namespace
+
 double uniform_from(std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   return std::uniform_real_distribution<double>(0.0, 1.0)(rng);
 }
-
-}  // namespace
 
 OutcomeWindows::OutcomeWindows(std::size_t keys, int window) : window_(window), outcomes_(keys) {
   if (keys == 0 || window_ < 1) throw std::invalid_argument("OutcomeWindows: no keys or an empty window");

@@ -23,6 +23,9 @@
 
 namespace comorph::coopt {
 
+// The uniform number in [0, 1) that one episode's stream (coopt::stream_seed) draws: every curriculum's draw.
+double uniform_from(std::uint64_t seed);
+
 // The last `window` outcomes (success or not) of each of `keys` kinds of
 // episode, and their text for a checkpoint ('1' / '0', keys separated by ',').
 class OutcomeWindows {

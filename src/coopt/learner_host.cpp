@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <random>
 
 #include "coopt/segment.hpp"
 #include "rl/learner.hpp"
@@ -114,8 +113,7 @@ Orders LearnerHost::start_orders(int episode) const {
   if (curriculum_episode(t, episode))
     o.stair_height_m = state_.curriculum.draw(height_weights_, stream_seed(t.seed, episode, 3));
   if (chain_curriculum_episode(t, episode)) {
-    std::mt19937_64 share(stream_seed(t.seed, episode, 4));
-    if (std::uniform_real_distribution<double>(0.0, 1.0)(share) < t.chain_curriculum) {
+    if (uniform_from(stream_seed(t.seed, episode, 4)) < t.chain_curriculum) {
       const ChainCurriculum::Pair pair = state_.chain_curriculum.draw(pair_weights_, stream_seed(t.seed, episode, 5));
       o.stair_height_m = pair.height_m;
       o.first_config = candidate_of(pair.modules);
