@@ -144,6 +144,9 @@ void add_fields(YamlFields& f, TrainerParams& p) {
         "forced in turn (every chain on the same scenes); 0 = none");
   f.add("refit_motion_from", &p.refit_motion_from,
         "a trained run whose motion model this run takes, frozen, to do only a refit (warm-up and episodes 0)");
+  f.add("keep_best_motion", &p.keep_best_motion,
+        "the refit freezes (and the run ends with) the motion model of the periodic evaluation with the highest "
+        "success (ties: higher F(H)) up to the refit's start, not the last one");
   f.add("scene_source", &p.scene_source,
         "where scene labels come from: ground_truth (the simulator) | classifier (ResNet-18 on depth)");
   f.add("classifier_dir", &p.classifier_dir, "directory of a trained classifier (scene_source: classifier)");
@@ -201,6 +204,10 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
     // A run without a single episode would end at once with no checkpoint to resume or evaluate.
     fail(source, pre + ".episodes", "warmup_episodes + episodes must be at least 1");
   }
+  if (p.keep_best_motion && (p.config_refit_episodes < 1 || p.episodes < 1 || p.eval_interval < 1))
+    fail(source, pre + ".keep_best_motion",
+         "needs training episodes (trainer.episodes >= 1), periodic evaluations (trainer.eval_interval >= 1) and a "
+         "refit that takes the best one (trainer.config_refit_episodes >= 1)");
   if (p.refit_sweep_scenes * kCandidates > p.config_refit_episodes)
     fail(source, pre + ".refit_sweep_scenes",
          std::to_string(p.refit_sweep_scenes) + " scenes x " + std::to_string(kCandidates) +

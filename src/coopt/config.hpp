@@ -198,6 +198,13 @@ struct TrainerParams {
   // already trained (other refit settings, another R2) without training it
   // again. The run copies the weights into its own checkpoints at its start.
   std::string refit_motion_from;
+  // The motion model the refit freezes (and the run ends with) is the one of
+  // the periodic evaluation up to the refit's start with the highest success
+  // (ties: higher F(H)), not the last: a TD3 policy's quality swings between
+  // updates (SB3's EvalCallback keeps its best model the same way). An
+  // evaluation is also taken at the refit's start. Its eval_episodes decide
+  // how reliable the choice is.
+  bool keep_best_motion = false;
   // Episode index of the refit's first episode (= warm-up + training episodes).
   int refit_start() const { return warmup_episodes + episodes; }
   // A checkpoint after this many episodes holds the refit DQN (built with dqn_refit:), not the training one.

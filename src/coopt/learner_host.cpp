@@ -6,7 +6,9 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <stdexcept>
 
+#include "coopt/run_store.hpp"
 #include "coopt/segment.hpp"
 #include "rl/learner.hpp"
 #include "rl/policy.hpp"
@@ -129,6 +131,7 @@ void LearnerHost::begin_block() {
     // greedy motion model; its replay starts empty, no segment of the old one to link.
     state_.start_refit(config_);
     state_.config_segments = {};
+    if (t.keep_best_motion) take_best_motion();
   }
   end_ = one_actor_ ? state_.episode + 1 : block_end(t, state_.episode);
   next_ = state_.episode;
@@ -280,11 +283,13 @@ void LearnerHost::end_block() {
   laps.lap(kHandover);
   if (record_) return;  // measure_side_rates: the acting side alone
   const bool last = state_.episode == t.total_episodes();
-  if (t.eval_interval > 0 && (state_.episode % t.eval_interval == 0 || last)) {
+  const bool refit_start = t.keep_best_motion && state_.episode == t.refit_start();  // the last model's score too
+  if (t.eval_interval > 0 && (state_.episode % t.eval_interval == 0 || last || refit_start)) {
     const EvaluationLog e = periodic_evaluation();
     ++state_.evaluations;
     laps.lap(kEvaluation);
     std::fprintf(stderr, "%s\n", store_.append_evaluation(config_, e).c_str());
+    if (t.keep_best_motion && state_.episode <= t.refit_start()) keep_if_best(e);
     if (callbacks_.on_evaluation) callbacks_.on_evaluation(e);
     laps.lap(kLogging);
   }
@@ -313,6 +318,33 @@ EvaluationLog LearnerHost::periodic_evaluation() {
     e.episodes.push_back(std::move(log));
   }
   return e;
+}
+
+void LearnerHost::keep_if_best(const EvaluationLog& e) {
+  const EvaluationScore score = evaluation_score(config_, e);
+  const bool better = !state_.best_motion || score.success > state_.best_motion_success ||
+                      (score.success == state_.best_motion_success && score.F > state_.best_motion_F);
+  if (!better) return;
+  if (!state_.best_motion) state_.best_motion = make_motion_policy(config_, 0);
+  state_.best_motion->sync_from(*state_.motion);  // the evaluated networks: the learner has not updated since
+  state_.best_motion_episode = e.train_episode;
+  state_.best_motion_success = score.success;
+  state_.best_motion_F = score.F;
+}
+
+void LearnerHost::take_best_motion() {
+  if (!state_.best_motion) throw std::logic_error("trainer.keep_best_motion: no evaluated motion model at the refit");
+  // Through a file: a learner takes acting networks only from one (Learner::load_acting_networks).
+  const std::string path = store_.path("best_motion_actor.pt.tmp");
+  state_.best_motion->save(path);
+  state_.motion->load_acting_networks(path);
+  std::filesystem::remove(path);
+  state_.agent.motion->sync_from(*state_.motion);
+  motion_updates_ = -1;  // new weights without an update: the actors must get them
+  std::fprintf(stderr,
+               "refit: the motion model of the evaluation after %d episodes (success %.2f, F(H) %.3f; "
+               "trainer.keep_best_motion)\n",
+               state_.best_motion_episode, state_.best_motion_success, state_.best_motion_F);
 }
 
 void LearnerHost::take_motion_model(const std::string& run_dir) {

@@ -70,6 +70,10 @@ class LearnerHost {
   void ingest_one(Rollout& r);
   void ingest_lockstep(std::vector<Rollout*>& rollouts);
   void take_motion_model(const std::string& run_dir);
+  // trainer.keep_best_motion: keeps the evaluated motion model when `e` beats
+  // the best so far; the refit's start puts the best into the learner.
+  void keep_if_best(const EvaluationLog& e);
+  void take_best_motion();
   void log_episode(const EpisodeLog& log);
   void progress(const EpisodeLog& log);
   EvaluationLog periodic_evaluation();

@@ -256,6 +256,12 @@ void RunStore::append_episode(const EpisodeLog& log) const {
   append_file(path("episodes.csv"), text.substr(text.find('\n') + 1));  // the row without the header
 }
 
+EvaluationScore evaluation_score(const CooptConfig& config, const EvaluationLog& evaluation) {
+  const std::vector<report::EpisodeRecord> records(evaluation.episodes.begin(), evaluation.episodes.end());
+  const auto m = report::summarize(records, config.env.task.objective, stair_heights(config));
+  return {m.success_rate.at("avg"), m.F};
+}
+
 std::string RunStore::append_evaluation(const CooptConfig& config, const EvaluationLog& e) const {
   std::vector<report::EpisodeRecord> records;
   double ret = 0, dist = 0;
@@ -337,6 +343,10 @@ void RunStore::write_checkpoint_files(const TrainingState& s, const CooptConfig&
     motion_next = rl::write_replay_segments(s.motion->replay(), "motion", tmp, s.motion_segments, files, sums);
   }
   s.agent.motion->save((fs::path(tmp) / "motion_actor.pt").string());  // the acting side: networks, counters, RNG
+  if (s.best_motion) {
+    s.best_motion->save((fs::path(tmp) / "best_motion_actor.pt").string());
+    files.push_back("best_motion_actor.pt");
+  }
   if (s.config) {
     s.config->save_without_replay((fs::path(tmp) / "config_model.pt").string());
     files.push_back("config_model.pt");
@@ -351,6 +361,13 @@ void RunStore::write_checkpoint_files(const TrainingState& s, const CooptConfig&
   e << YAML::Key << "rng" << YAML::Value << rl::rng_state(s.rng);
   e << YAML::Key << "stair_curriculum" << YAML::Value << s.curriculum.outcomes_text();
   e << YAML::Key << "chain_curriculum" << YAML::Value << s.chain_curriculum.outcomes_text();
+  if (s.best_motion) {  // the score exactly (shortest round trip), so a resumed run compares as the uninterrupted one
+    e << YAML::Key << "best_motion" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "episode" << YAML::Value << s.best_motion_episode;
+    e << YAML::Key << "success" << YAML::Value << fmt::format("{}", s.best_motion_success);
+    e << YAML::Key << "F" << YAML::Value << fmt::format("{}", s.best_motion_F);
+    e << YAML::EndMap;
+  }
   // env_files ends with a newline, which a literal block keeps; config has
   // none, which only the last value of the document keeps.
   e << YAML::Key << "env_files" << YAML::Value << YAML::Literal << config.env_text;
@@ -391,6 +408,17 @@ void RunStore::load_checkpoint(TrainingState& s, const CooptConfig& config) cons
   };
   outcomes("stair_curriculum", s.curriculum);
   outcomes("chain_curriculum", s.chain_curriculum);
+  if (const YAML::Node best = n["best_motion"]) {
+    try {
+      s.best_motion_episode = best["episode"].as<int>();
+      s.best_motion_success = best["success"].as<double>();
+      s.best_motion_F = best["F"].as<double>();
+    } catch (const YAML::Exception& e) {
+      throw std::runtime_error(info.directory + "/trainer.yaml: best_motion: " + e.msg + "; refusing to resume");
+    }
+    s.best_motion = make_motion_policy(config, 0);
+    load_learner_file(*s.best_motion, (fs::path(info.directory) / "best_motion_actor.pt").string());
+  }
   s.episode = info.episodes;
   s.evaluations = info.evaluations;
   s.steps = info.env_steps;

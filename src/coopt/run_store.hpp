@@ -25,6 +25,13 @@ std::string checkpoint_dir_of(const std::string& run_dir);
 void load_learner_file(rl::Learner& learner, const std::string& path);
 void load_learner_file(rl::Policy& policy, const std::string& path);
 
+// An evaluation's success (the average over its stair heights) and F(H), as evaluations.csv gives them.
+struct EvaluationScore {
+  double success = 0;
+  double F = 0;
+};
+EvaluationScore evaluation_score(const CooptConfig& config, const EvaluationLog& evaluation);
+
 class RunStore {
  public:
   explicit RunStore(std::string run_dir) : dir_(std::move(run_dir)) {}

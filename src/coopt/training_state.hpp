@@ -39,6 +39,12 @@ struct TrainingState {
   int evaluations = 0;                  // periodic evaluations done (= rows of evaluations.csv)
   std::int64_t steps = 0;               // training control steps
   double wall_before = 0;               // training wall time of the earlier sessions (resume), s
+  // trainer.keep_best_motion: the motion model's acting networks at its best
+  // periodic evaluation so far (nullptr before the first), and that score.
+  std::unique_ptr<rl::Policy> best_motion;
+  int best_motion_episode = -1;         // training episodes done at that evaluation
+  double best_motion_success = 0;       // its success, the stair heights' average
+  double best_motion_F = 0;             // its F(H)
   StairCurriculum curriculum;           // the training episodes' recent outcomes per stair height
   ChainCurriculum chain_curriculum;     // ... and per (stair height, first chain) pair
   // The replay segments of the last checkpoint written or loaded: the next

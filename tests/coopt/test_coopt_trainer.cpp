@@ -52,6 +52,7 @@ struct RunResult {
   std::vector<EpisodeLog> logs;
   std::vector<DecisionLog> decisions;
   int evaluations = 0;
+  std::vector<EvaluationLog> evaluation_logs;
 };
 
 TrainerCallbacks collecting(RunResult& r) {
@@ -60,7 +61,10 @@ TrainerCallbacks collecting(RunResult& r) {
     r.episodes.push_back(line_of(l));
     r.logs.push_back(l);
   };
-  cb.on_evaluation = [&r](const EvaluationLog& e) { r.evaluations += 1; };
+  cb.on_evaluation = [&r](const EvaluationLog& e) {
+    r.evaluations += 1;
+    r.evaluation_logs.push_back(e);
+  };
   cb.on_decision = [&r](const DecisionLog& d) { r.decisions.push_back(d); };
   return cb;
 }
@@ -707,6 +711,90 @@ TEST(Trainer, RefitOfAnotherRunsMotionModel) {
                       bad),
                std::runtime_error);
   for (const std::string& d : {a, b, missing, bad}) fs::remove_all(d);
+}
+
+// trainer.keep_best_motion: the refit freezes the motion model of the
+// periodic evaluation with the highest success (ties: higher F(H)) up to the
+// refit's start, where one more evaluation is taken; the run ends with it; a
+// run interrupted before the refit resumes to the same choice.
+TEST(Trainer, KeepBestMotionFreezesTheBestEvaluatedMotionModel) {
+  // ci: 2 warm-up + 4 training episodes, then 3 refit episodes; an evaluation after every episode.
+  const std::vector<std::string> plain{"trainer.config_refit_episodes=3", "trainer.eval_interval=1",
+                                       "trainer.checkpoint_interval=1"};
+  const std::vector<std::string> best = with(plain, "trainer.keep_best_motion=true");
+  const std::string dir = temp_dir("best"), plain_dir = temp_dir("best_plain"), cut_dir = temp_dir("best_cut");
+  const RunResult r = run_ci(best, dir);
+  ASSERT_EQ(r.evaluation_logs.size(), 9u);
+  // The best of the evaluations after episodes 1 to 6, computed here from their episodes.
+  int expected = -1;
+  double best_success = -1, best_F = 0;
+  for (const EvaluationLog& e : r.evaluation_logs) {
+    if (e.train_episode > 6) continue;
+    std::map<double, std::pair<int, int>> per_height;  // wins, episodes
+    double F = 0;
+    for (const EpisodeLog& l : e.episodes) {
+      per_height[l.stair_height_m].first += l.success;
+      per_height[l.stair_height_m].second += 1;
+      F += l.F / static_cast<double>(e.episodes.size());
+    }
+    double success = 0;
+    for (const auto& [h, wc] : per_height) success += static_cast<double>(wc.first) / wc.second / per_height.size();
+    if (success > best_success || (success == best_success && F > best_F)) {
+      expected = e.train_episode;
+      best_success = success;
+      best_F = F;
+    }
+  }
+  // This seed's best comes before the last training episode, so the kept model differs from the last one.
+  ASSERT_GE(expected, 1);
+  ASSERT_LT(expected, 6);
+  const YAML::Node kept = YAML::LoadFile(dir + "/checkpoint/trainer.yaml")["best_motion"];
+  ASSERT_TRUE(kept);
+  EXPECT_EQ(kept["episode"].as<int>(), expected);
+
+  // The final motion model is the one after `expected` episodes: the same greedy
+  // episodes on a forced chain as a run without the option stopped there, and
+  // not those of that run's last model.
+  const CooptConfig plain_config = load_coopt_config(kCi, plain);
+  RunResult cut;
+  run_until_stopped(plain_config, cut_dir, expected - 1, cut);
+  const RunResult plain_run = run_ci(plain, plain_dir);
+  for (int e = 0; e < 6; ++e) EXPECT_EQ(r.episodes[e], plain_run.episodes[e]) << "episode " << e;
+  // The refit's episodes are driven by the kept model (the actors got its weights), not the last one.
+  ASSERT_EQ(plain_run.episodes.size(), 9u);
+  EXPECT_NE(std::vector<std::string>(r.episodes.begin() + 6, r.episodes.end()),
+            std::vector<std::string>(plain_run.episodes.begin() + 6, plain_run.episodes.end()));
+  EvalRequest req;
+  req.episodes = 3;
+  req.seed = 31;
+  req.workers = 1;
+  req.forced_modules = 4;
+  const auto lines = [&](const CooptConfig& c, const std::string& run) {
+    std::vector<std::string> out;
+    for (const EpisodeLog& l : evaluate(c, run, req)) out.push_back(line_of(l));
+    return out;
+  };
+  const CooptConfig best_config = load_coopt_config(kCi, best);
+  EXPECT_EQ(lines(best_config, dir), lines(plain_config, cut_dir));
+  EXPECT_NE(lines(best_config, dir), lines(plain_config, plain_dir));
+
+  // Interrupted after episode 4 and resumed: the same episodes, refit included, and the same choice.
+  const std::string resumed_dir = temp_dir("best_resumed");
+  RunResult resumed;
+  run_until_stopped(best_config, resumed_dir, 3, resumed);
+  {
+    Trainer t(best_config, resumed_dir, collecting(resumed));
+    t.resume();
+    EXPECT_TRUE(t.run());
+  }
+  EXPECT_EQ(resumed.episodes, r.episodes);
+  EXPECT_EQ(YAML::LoadFile(resumed_dir + "/checkpoint/trainer.yaml")["best_motion"]["episode"].as<int>(), expected);
+  EXPECT_EQ(lines(best_config, resumed_dir), lines(best_config, dir));
+
+  // Without a refit to take it, the option is refused, naming the key.
+  const std::string refused = test_support::error_of([&] { load_coopt_config(kCi, {"trainer.keep_best_motion=true"}); });
+  EXPECT_NE(refused.find("trainer.keep_best_motion"), std::string::npos) << refused;
+  for (const std::string& d : {dir, plain_dir, cut_dir, resumed_dir}) fs::remove_all(d);
 }
 
 // scene_source: classifier runs the ResNet-18 on the last 10 depth frames at
