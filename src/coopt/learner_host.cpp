@@ -321,15 +321,16 @@ EvaluationLog LearnerHost::periodic_evaluation() {
 }
 
 void LearnerHost::keep_if_best(const EvaluationLog& e) {
-  const EvaluationScore score = evaluation_score(config_, e);
-  const bool better = !state_.best_motion || score.success > state_.best_motion_success ||
-                      (score.success == state_.best_motion_success && score.F > state_.best_motion_F);
+  const report::EvalSummary m = evaluation_summary(config_, e);
+  const double success = m.success_rate.at("avg");
+  const bool better = !state_.best_motion || success > state_.best_motion_success ||
+                      (success == state_.best_motion_success && m.F > state_.best_motion_F);
   if (!better) return;
   if (!state_.best_motion) state_.best_motion = make_motion_policy(config_, 0);
   state_.best_motion->sync_from(*state_.motion);  // the evaluated networks: the learner has not updated since
   state_.best_motion_episode = e.train_episode;
-  state_.best_motion_success = score.success;
-  state_.best_motion_F = score.F;
+  state_.best_motion_success = success;
+  state_.best_motion_F = m.F;
 }
 
 void LearnerHost::take_best_motion() {

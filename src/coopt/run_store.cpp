@@ -256,21 +256,18 @@ void RunStore::append_episode(const EpisodeLog& log) const {
   append_file(path("episodes.csv"), text.substr(text.find('\n') + 1));  // the row without the header
 }
 
-EvaluationScore evaluation_score(const CooptConfig& config, const EvaluationLog& evaluation) {
+report::EvalSummary evaluation_summary(const CooptConfig& config, const EvaluationLog& evaluation) {
   const std::vector<report::EpisodeRecord> records(evaluation.episodes.begin(), evaluation.episodes.end());
-  const auto m = report::summarize(records, config.env.task.objective, stair_heights(config));
-  return {m.success_rate.at("avg"), m.F};
+  return report::summarize(records, config.env.task.objective, stair_heights(config));
 }
 
 std::string RunStore::append_evaluation(const CooptConfig& config, const EvaluationLog& e) const {
-  std::vector<report::EpisodeRecord> records;
   double ret = 0, dist = 0;
   for (const auto& l : e.episodes) {
-    records.push_back(l);
     ret += l.return_R1;
     dist += l.distance_fraction;
   }
-  const auto m = report::summarize(records, config.env.task.objective, stair_heights(config));
+  const report::EvalSummary m = evaluation_summary(config, e);
   const double n = static_cast<double>(e.episodes.size());
   std::string configs;  // "0.04:4x2|6->2x1 0.06:..."
   for (const auto& [height, seqs] : m.configurations) {

@@ -14,6 +14,7 @@
 
 #include "coopt/config.hpp"
 #include "coopt/training_state.hpp"
+#include "report/metrics.hpp"
 
 namespace comorph::coopt {
 
@@ -25,12 +26,8 @@ std::string checkpoint_dir_of(const std::string& run_dir);
 void load_learner_file(rl::Learner& learner, const std::string& path);
 void load_learner_file(rl::Policy& policy, const std::string& path);
 
-// An evaluation's success (the average over its stair heights) and F(H), as evaluations.csv gives them.
-struct EvaluationScore {
-  double success = 0;
-  double F = 0;
-};
-EvaluationScore evaluation_score(const CooptConfig& config, const EvaluationLog& evaluation);
+// An evaluation's figures (success per stair height and their average, F(H), ...), as evaluations.csv gives them.
+report::EvalSummary evaluation_summary(const CooptConfig& config, const EvaluationLog& evaluation);
 
 class RunStore {
  public:
