@@ -10,6 +10,7 @@ packages=(
   libblas-dev                                       # cblas.h: the TD3 update's own matrix products (rl/mlp_pass)
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
   nlohmann-json3-dev                                # JSON of evaluation summaries (report)
+  zlib1g-dev                                        # gzip of an exported run's episodes.csv.gz (common/gzip)
   libgtest-dev libgmock-dev libbenchmark-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri libgl-dev # headless rendering
   libopengl-dev                                     # libOpenGL.so: GL without GLX, for EGL (report)

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "common/file_io.hpp"
+#include "common/gzip.hpp"
 
 namespace comorph::report {
 namespace {
@@ -180,6 +181,12 @@ std::vector<EpisodeRecord> read_episodes_csv(std::istream& in, const std::string
 }
 
 std::vector<EpisodeRecord> read_episodes_csv(const std::string& path) {
+  if (has_gzip_suffix(path)) {
+    // An exported run's log (`comorph export`): a few hundred KiB unpacked.
+    constexpr std::size_t kMaxLogBytes = 256u << 20;
+    std::istringstream text(gzip_decompress(read_text_file(path, kMaxLogBytes), path, kMaxLogBytes));
+    return read_episodes_csv(text, path);
+  }
   std::ifstream in(path);
   if (!in) throw std::runtime_error(fmt::format("cannot open episode log {}", path));
   return read_episodes_csv(in, path);

@@ -28,6 +28,7 @@ void write_episodes_csv(const std::string& path, const std::vector<EpisodeRecord
 // finite (nan, inf) and an episode whose row appears twice. Errors throw with
 // "source:line:column: message" (column = 1-based character position).
 std::vector<EpisodeRecord> read_episodes_csv(std::istream& in, const std::string& source_name);
+// A path ending in .gz is read as gzip (an exported run's episodes.csv.gz).
 std::vector<EpisodeRecord> read_episodes_csv(const std::string& path);
 
 using task::configuration_sequence;  // "4->2" for {4, 2}

@@ -96,7 +96,10 @@ RunDir load_run_dir(const std::string& path, const ConfigIdentity& identity) {
   const fs::path dir(path);
   std::vector<std::string> missing;
   const fs::path yaml = dir / "run.yaml";
-  const fs::path csv = dir / "episodes.csv";
+  // An exported run (`comorph export`, results/) keeps its log as episodes.csv.gz.
+  const fs::path csv = fs::is_regular_file(dir / "episodes.csv.gz") && !fs::exists(dir / "episodes.csv")
+                           ? dir / "episodes.csv.gz"
+                           : dir / "episodes.csv";
   if (!fs::is_regular_file(yaml)) missing.push_back(yaml.string());
   if (!fs::is_regular_file(csv)) missing.push_back(csv.string());
   std::vector<fs::path> evals;

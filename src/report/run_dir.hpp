@@ -1,6 +1,7 @@
 // A run directory as the trainer/evaluator leaves it (layout: docs/report.md):
 //   run.yaml             what the run is (RunInfo below)
-//   episodes.csv         one row per training episode (episode_record.hpp)
+//   episodes.csv         one row per training episode (episode_record.hpp);
+//                        episodes.csv.gz in an exported run (results/)
 //   eval-<scenario>.json one evaluation summary per test scenario (metrics.hpp)
 //   config.yaml          optional here: the run's configuration (its training seed)
 #pragma once
@@ -38,7 +39,7 @@ struct RunDir {
   std::string path;
   RunInfo info;
   std::map<std::string, EvalSummary> evals;  // test scenario -> its eval-<scenario>.json
-  std::string episodes_csv;              // path of episodes.csv
+  std::string episodes_csv;              // path of episodes.csv (or episodes.csv.gz)
   // From config.yaml when the run has one: its trainer.seed (0: no
   // config.yaml), and the configuration without that seed (ConfigIdentity),
   // so that the runs of one configuration trained with different seeds can be

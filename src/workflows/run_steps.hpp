@@ -49,7 +49,7 @@ report::EvalSummary eval_run(const std::string& run_dir, const std::string& scen
                          int workers, int forced_modules = 0, bool pilot_drives = false);
 
 // Copies what `eval`, `render` and `report` need of a trained run into `out`
-// (config.yaml, run.yaml, episodes.csv rounded to the report's digits,
+// (config.yaml, run.yaml, episodes.csv.gz: the log rounded to the report's digits and gzipped,
 // evaluations.csv, eval-*.json) with a checkpoint/ of the acting networks only (no replay, no
 // optimizers): a trained policy small enough to ship in the repository. The
 // copy evaluates like the run; it cannot resume training. Returns its bytes.

@@ -37,9 +37,11 @@ TEST(ShippedResults, EveryRunIsSmallAndHasWhatEvalRenderAndReportNeed) {
     for (const auto& f : fs::recursive_directory_iterator(run.path()))
       if (f.is_regular_file()) bytes += f.file_size();
     EXPECT_LE(bytes, 2000000u) << run.path();
-    for (const char* name : {"config.yaml", "run.yaml", "episodes.csv", "checkpoint/trainer.yaml",
-                             "checkpoint/motion_actor.pt", "checkpoint/checksums.txt"})
+    for (const char* name : {"config.yaml", "run.yaml", "checkpoint/trainer.yaml", "checkpoint/motion_actor.pt",
+                             "checkpoint/checksums.txt"})
       EXPECT_TRUE(fs::exists(run.path() / name)) << run.path() / name;
+    // The training log: gzipped by `comorph export`, plain in runs shipped before it gzipped.
+    EXPECT_TRUE(fs::exists(run.path() / "episodes.csv.gz") || fs::exists(run.path() / "episodes.csv")) << run.path();
     EXPECT_FALSE(fs::exists(run.path() / "checkpoint" / "motion.pt")) << "a replay buffer ships in " << run.path();
   }
 }
