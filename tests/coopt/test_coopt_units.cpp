@@ -290,6 +290,24 @@ TEST(CooptConfig, APresetBuildsOnItsBase) {
   std::filesystem::remove_all(dir);
 }
 
+// configs/rl-only-curricula.yaml is the recipe docs/results.md measured
+// ("Three seeds of the chain curriculum"): rl-only.yaml with these settings,
+// nothing more; and it stays RL alone (no pilot acts or labels).
+TEST(CooptConfig, TheRlOnlyCurriculaPresetIsTheMeasuredRecipe) {
+  const std::string configs = std::string(COMORPH_SOURCE_DIR) + "/configs/";
+  const CooptConfig preset = load_coopt_config(configs + "rl-only-curricula.yaml");
+  const CooptConfig measured = load_coopt_config(
+      configs + "rl-only.yaml",
+      {"trainer.stair_curriculum=0.5", "trainer.config_energy_weight=0.02", "trainer.chain_curriculum=0.5",
+       "trainer.decision_image_first_only=true", "dqn_refit.reward_scale=0.01", "dqn_refit.learning_rate=1e-3",
+       "dqn_refit.weight_decay=0.5"});
+  EXPECT_EQ(preset.text, measured.text);
+  EXPECT_EQ(preset.preset, "rl-only-curricula");
+  EXPECT_FALSE(preset.trainer.pilot_labels);
+  EXPECT_EQ(preset.trainer.scripted_interval, 0);
+  EXPECT_EQ(preset.td3.bc_weight, 0);
+}
+
 // An empty file is refused as empty (not as a file without a td3: section);
 // a key that is a list names the file and the line.
 TEST(CooptConfig, AnEmptyFileOrAListKeyIsRefusedAsSuch) {
