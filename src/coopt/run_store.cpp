@@ -67,9 +67,6 @@ std::string first_difference(const std::string& a, const std::string& b) {
   }
 }
 
-// Largest episodes.csv / evaluations.csv a resume reads (4300 episodes take ~0.5 MB).
-constexpr std::size_t kMaxRunCsvBytes = 256u << 20;
-
 // The header of evaluations.csv: a success column per stair height of the run.
 std::string evaluation_columns(const CooptConfig& config) {
   std::string columns = "train_episode,env_steps,wall_s,episodes";
@@ -84,7 +81,7 @@ std::string format_rate(double v) { return std::isnan(v) ? std::string("-") : fm
 std::vector<std::string> csv_data_lines(const std::string& path, std::string& header) {
   std::vector<std::string> lines;
   if (!fs::exists(path)) return lines;
-  std::istringstream in(read_text_file(path, kMaxRunCsvBytes));
+  std::istringstream in(read_text_file(path, report::kMaxRunLogBytes));
   std::getline(in, header);
   for (std::string line; std::getline(in, line);) lines.push_back(line);
   return lines;

@@ -182,9 +182,8 @@ std::vector<EpisodeRecord> read_episodes_csv(std::istream& in, const std::string
 
 std::vector<EpisodeRecord> read_episodes_csv(const std::string& path) {
   if (has_gzip_suffix(path)) {
-    // An exported run's log (`comorph export`): a few hundred KiB unpacked.
-    constexpr std::size_t kMaxLogBytes = 256u << 20;
-    std::istringstream text(gzip_decompress(read_text_file(path, kMaxLogBytes), path, kMaxLogBytes));
+    // An exported run's log (`comorph export`).
+    std::istringstream text(gzip_decompress(read_text_file(path, kMaxRunLogBytes), path, kMaxRunLogBytes));
     return read_episodes_csv(text, path);
   }
   std::ifstream in(path);

@@ -1,6 +1,7 @@
 // CSV form of the episode records (task/episode_record.hpp).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <iosfwd>
 #include <string>
@@ -14,6 +15,9 @@ using task::EpisodeRecord;  // defined in task/episode_record.hpp
 
 // The CSV header, comma separated, in the order the columns are written.
 const std::vector<std::string>& episode_csv_columns();
+
+// Largest run log (episodes.csv, evaluations.csv, unpacked) comorph reads: 4300 episodes take ~0.5 MB.
+inline constexpr std::size_t kMaxRunLogBytes = 256u << 20;
 
 // CSV with a header row; one row per record. `configurations` is written as
 // modules joined by ';' (e.g. "4;2"); success as 0/1; numbers so that reading

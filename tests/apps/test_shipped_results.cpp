@@ -40,7 +40,7 @@ TEST(ShippedResults, EveryRunIsSmallAndHasWhatEvalRenderAndReportNeed) {
     for (const char* name : {"config.yaml", "run.yaml", "checkpoint/trainer.yaml", "checkpoint/motion_actor.pt",
                              "checkpoint/checksums.txt"})
       EXPECT_TRUE(fs::exists(run.path() / name)) << run.path() / name;
-    // The training log: gzipped by `comorph export`, plain in runs shipped before it gzipped.
+    // The training log: episodes.csv.gz as `comorph export` writes it, or plain episodes.csv.
     EXPECT_TRUE(fs::exists(run.path() / "episodes.csv.gz") || fs::exists(run.path() / "episodes.csv")) << run.path();
     EXPECT_FALSE(fs::exists(run.path() / "checkpoint" / "motion.pt")) << "a replay buffer ships in " << run.path();
   }
