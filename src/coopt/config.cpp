@@ -147,6 +147,12 @@ void add_fields(YamlFields& f, TrainerParams& p) {
   f.add("keep_best_motion", &p.keep_best_motion,
         "the refit freezes (and the run ends with) the motion model of the periodic evaluation with the highest "
         "success (ties: higher F(H)) up to the refit's start, not the last one");
+  f.add("motion_average_episodes", &p.motion_average_episodes, 0, kMaxEpisodes,
+        "> 0: the refit freezes (and the run ends with) the mean of the motion model's networks taken every "
+        "motion_average_interval episodes over the last this-many training episodes and at the refit's start; "
+        "0 = the last model");
+  f.add("motion_average_interval", &p.motion_average_interval, 1, kMaxEpisodes,
+        "training episodes between the snapshots of trainer.motion_average_episodes");
   f.add("scene_source", &p.scene_source,
         "where scene labels come from: ground_truth (the simulator) | classifier (ResNet-18 on depth)");
   f.add("classifier_dir", &p.classifier_dir, "directory of a trained classifier (scene_source: classifier)");
@@ -208,6 +214,15 @@ TrainerParams read_trainer(const YAML::Node& n, const std::string& source) {
     fail(source, pre + ".keep_best_motion",
          "needs training episodes (trainer.episodes >= 1), periodic evaluations (trainer.eval_interval >= 1) and a "
          "refit that takes the best one (trainer.config_refit_episodes >= 1)");
+  if (p.motion_average_episodes > 0) {
+    if (p.keep_best_motion)
+      fail(source, pre + ".motion_average_episodes",
+           "cannot be used with trainer.keep_best_motion (the refit freezes one motion model: the mean or the best)");
+    if (p.config_refit_episodes < 1 || p.motion_average_episodes > p.episodes)
+      fail(source, pre + ".motion_average_episodes",
+           std::to_string(p.motion_average_episodes) + " needs at least as many training episodes (trainer.episodes: " +
+               std::to_string(p.episodes) + ") and a refit that takes the mean (trainer.config_refit_episodes >= 1)");
+  }
   if (p.refit_sweep_scenes * kCandidates > p.config_refit_episodes)
     fail(source, pre + ".refit_sweep_scenes",
          std::to_string(p.refit_sweep_scenes) + " scenes x " + std::to_string(kCandidates) +

@@ -205,8 +205,21 @@ struct TrainerParams {
   // evaluation is also taken at the refit's start. Its eval_episodes decide
   // how reliable the choice is.
   bool keep_best_motion = false;
+  // > 0: the refit freezes (and the run ends with) the mean of the motion
+  // model's acting networks taken after every motion_average_interval-th
+  // episode over the last this-many training episodes, and at the refit's
+  // start: weight averaging (Izmailov et al. 2018; Nikishin et al. 2018 for
+  // RL), a steadier model than any one snapshot of a swinging TD3 policy.
+  int motion_average_episodes = 0;
+  int motion_average_interval = 50;
   // Episode index of the refit's first episode (= warm-up + training episodes).
   int refit_start() const { return warmup_episodes + episodes; }
+  // After this many episodes the motion model goes into the mean (trainer.motion_average_episodes).
+  bool motion_average_snapshot(int episodes_done) const {
+    return motion_average_episodes > 0 && episodes_done <= refit_start() &&
+           episodes_done >= refit_start() - motion_average_episodes &&
+           (episodes_done % motion_average_interval == 0 || episodes_done == refit_start());
+  }
   // A checkpoint after this many episodes holds the refit DQN (built with dqn_refit:), not the training one.
   bool holds_refit_dqn(int episodes_done) const { return episodes_done > refit_start(); }
   int total_episodes() const { return refit_start() + config_refit_episodes; }

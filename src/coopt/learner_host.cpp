@@ -132,6 +132,7 @@ void LearnerHost::begin_block() {
     state_.start_refit(config_);
     state_.config_segments = {};
     if (t.keep_best_motion) take_best_motion();
+    if (t.motion_average_episodes > 0) take_average_motion();
   }
   end_ = one_actor_ ? state_.episode + 1 : block_end(t, state_.episode);
   next_ = state_.episode;
@@ -293,6 +294,7 @@ void LearnerHost::end_block() {
     if (callbacks_.on_evaluation) callbacks_.on_evaluation(e);
     laps.lap(kLogging);
   }
+  if (t.motion_average_snapshot(state_.episode)) add_motion_snapshot();
   if (state_.episode % t.checkpoint_interval == 0 || last) checkpoint();
 }
 
@@ -333,19 +335,36 @@ void LearnerHost::keep_if_best(const EvaluationLog& e) {
   state_.best_motion_F = m.F;
 }
 
-void LearnerHost::take_best_motion() {
-  if (!state_.best_motion) throw std::logic_error("trainer.keep_best_motion: no evaluated motion model at the refit");
+void LearnerHost::take_motion(const rl::Policy& kept) {
   // Through a file: a learner takes acting networks only from one (Learner::load_acting_networks).
-  const std::string path = store_.path("best_motion_actor.pt.tmp");
-  state_.best_motion->save(path);
+  const std::string path = store_.path("kept_motion_actor.pt.tmp");
+  kept.save(path);
   state_.motion->load_acting_networks(path);
   std::filesystem::remove(path);
   state_.agent.motion->sync_from(*state_.motion);
   motion_updates_ = -1;  // new weights without an update: the actors must get them
+}
+
+void LearnerHost::take_best_motion() {
+  if (!state_.best_motion) throw std::logic_error("trainer.keep_best_motion: no evaluated motion model at the refit");
+  take_motion(*state_.best_motion);
   std::fprintf(stderr,
                "refit: the motion model of the evaluation after %d episodes (success %.2f, F(H) %.3f; "
                "trainer.keep_best_motion)\n",
                state_.best_motion_episode, state_.best_motion_success, state_.best_motion_F);
+}
+
+void LearnerHost::add_motion_snapshot() {
+  if (!state_.motion_average) state_.motion_average = make_motion_policy(config_, 0);
+  ++state_.motion_average_snapshots;
+  state_.motion_average->blend_from(*state_.motion, 1.0 / state_.motion_average_snapshots);
+}
+
+void LearnerHost::take_average_motion() {
+  if (!state_.motion_average) throw std::logic_error("trainer.motion_average_episodes: no snapshot at the refit");
+  take_motion(*state_.motion_average);
+  std::fprintf(stderr, "refit: the mean of %d snapshots of the motion model (trainer.motion_average_episodes %d)\n",
+               state_.motion_average_snapshots, config_.trainer.motion_average_episodes);
 }
 
 void LearnerHost::take_motion_model(const std::string& run_dir) {

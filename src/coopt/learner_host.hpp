@@ -74,6 +74,11 @@ class LearnerHost {
   // the best so far; the refit's start puts the best into the learner.
   void keep_if_best(const EvaluationLog& e);
   void take_best_motion();
+  // trainer.motion_average_episodes: the learner's motion model into the running mean; the refit takes the mean.
+  void add_motion_snapshot();
+  void take_average_motion();
+  // The refit's frozen motion model: `kept`'s networks into the learner and the acting copies.
+  void take_motion(const rl::Policy& kept);
   void log_episode(const EpisodeLog& log);
   void progress(const EpisodeLog& log);
   EvaluationLog periodic_evaluation();

@@ -341,6 +341,10 @@ void RunStore::write_checkpoint_files(const TrainingState& s, const CooptConfig&
     s.best_motion->save((fs::path(tmp) / "best_motion_actor.pt").string());
     files.push_back("best_motion_actor.pt");
   }
+  if (s.motion_average) {
+    s.motion_average->save((fs::path(tmp) / "average_motion_actor.pt").string());
+    files.push_back("average_motion_actor.pt");
+  }
   if (s.config) {
     s.config->save_without_replay((fs::path(tmp) / "config_model.pt").string());
     files.push_back("config_model.pt");
@@ -362,6 +366,7 @@ void RunStore::write_checkpoint_files(const TrainingState& s, const CooptConfig&
     e << YAML::Key << "F" << YAML::Value << fmt::format("{}", s.best_motion_F);
     e << YAML::EndMap;
   }
+  if (s.motion_average) e << YAML::Key << "motion_average_snapshots" << YAML::Value << s.motion_average_snapshots;
   // env_files ends with a newline, which a literal block keeps; config has
   // none, which only the last value of the document keeps.
   e << YAML::Key << "env_files" << YAML::Value << YAML::Literal << config.env_text;
@@ -412,6 +417,16 @@ void RunStore::load_checkpoint(TrainingState& s, const CooptConfig& config) cons
     }
     s.best_motion = make_motion_policy(config, 0);
     load_learner_file(*s.best_motion, (fs::path(info.directory) / "best_motion_actor.pt").string());
+  }
+  if (const YAML::Node snapshots = n["motion_average_snapshots"]) {
+    try {
+      s.motion_average_snapshots = snapshots.as<int>();
+    } catch (const YAML::Exception& e) {
+      throw std::runtime_error(info.directory + "/trainer.yaml: motion_average_snapshots: " + e.msg +
+                               "; refusing to resume");
+    }
+    s.motion_average = make_motion_policy(config, 0);
+    load_learner_file(*s.motion_average, (fs::path(info.directory) / "average_motion_actor.pt").string());
   }
   s.episode = info.episodes;
   s.evaluations = info.evaluations;

@@ -45,6 +45,10 @@ struct TrainingState {
   int best_motion_episode = -1;         // training episodes done at that evaluation
   double best_motion_success = 0;       // its success, the stair heights' average
   double best_motion_F = 0;             // its F(H)
+  // trainer.motion_average_episodes: the running mean of the motion model's
+  // acting networks (nullptr before the first snapshot) and how many it holds.
+  std::unique_ptr<rl::Policy> motion_average;
+  int motion_average_snapshots = 0;
   StairCurriculum curriculum;           // the training episodes' recent outcomes per stair height
   ChainCurriculum chain_curriculum;     // ... and per (stair height, first chain) pair
   // The replay segments of the last checkpoint written or loaded: the next

@@ -124,6 +124,14 @@ void copy_parameters(torch::nn::Module& dst, const torch::nn::Module& src) {
   for (std::size_t i = 0; i < d.size(); ++i) d[i].copy_(s[i]);
 }
 
+void blend_parameters(torch::nn::Module& dst, const torch::nn::Module& src, double weight) {
+  torch::NoGradGuard no_grad;
+  auto d = dst.parameters();
+  const auto s = src.parameters();
+  if (d.size() != s.size()) throw std::logic_error("blend_parameters: architectures differ");
+  for (std::size_t i = 0; i < d.size(); ++i) d[i].mul_(1.0 - weight).add_(s[i], weight);
+}
+
 torch::Tensor image_batch(const Observation& o, const ObservationSpec& spec,
                           const torch::Device& device) {
   if (!spec.has_image()) return {};

@@ -118,6 +118,9 @@ TORCH_MODULE(ActorCritic);
 
 // dst <- src, parameter by parameter (same architecture).
 void copy_parameters(torch::nn::Module& dst, const torch::nn::Module& src);
+// dst <- (1 - weight) dst + weight src, parameter by parameter (same
+// architecture): weight 1 / k for the k-th of k snapshots keeps their mean.
+void blend_parameters(torch::nn::Module& dst, const torch::nn::Module& src, double weight);
 
 // A batch of one observation as tensors on `device` ([1, C, H, W] and [1, V];
 // undefined where the spec has none).

@@ -11,6 +11,10 @@ namespace comorph::rl {
 
 void Policy::sync_from(const Learner& learner) { copy_parameters(acting_module(), learner.acting_networks()); }
 
+void Policy::blend_from(const Learner& learner, double weight) {
+  blend_parameters(acting_module(), learner.acting_networks(), weight);
+}
+
 void acting_weights(const Learner& learner, std::vector<float>& weights) {
   const auto parameters = learner.acting_networks().parameters();
   std::size_t size = 0;

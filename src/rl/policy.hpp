@@ -42,6 +42,9 @@ class Policy {
   }
   // Copies the learner's acting networks (Learner::acting_networks) into this copy.
   void sync_from(const Learner& learner);
+  // Moves this copy's networks towards the learner's: (1 - weight) mine +
+  // weight its (a running mean of snapshots: weight 1 / k at the k-th).
+  void blend_from(const Learner& learner, double weight);
   // The same from acting_weights()' buffer (an acting copy in another thread
   // or process is sent these bytes).
   void load_weights(const std::vector<float>& weights);

@@ -24,6 +24,7 @@
 #include "coopt/segment.hpp"
 #include "coopt/curriculum.hpp"
 #include "coopt/trainer.hpp"
+#include "coopt/training_state.hpp"
 #include "perception/params.hpp"
 #include "perception/scene_classifier.hpp"
 #include "support/test_support.hpp"
@@ -98,6 +99,17 @@ void resume_until_killed(const CooptConfig& c, const std::string& dir, int done,
   t.resume();
   EXPECT_EQ(t.episodes_done(), done);
   EXPECT_THROW(t.run(), std::runtime_error);
+}
+
+// A run in `dir` interrupted after episode index `last` ends, then resumed
+// to its end: every episode's row, in order.
+RunResult run_stopped_and_resumed(const CooptConfig& c, const std::string& dir, int last) {
+  RunResult r;
+  run_until_stopped(c, dir, last, r);
+  Trainer t(c, dir, collecting(r));
+  t.resume();
+  EXPECT_TRUE(t.run());
+  return r;
 }
 
 // `sets` and one more.
@@ -780,13 +792,7 @@ TEST(Trainer, KeepBestMotionFreezesTheBestEvaluatedMotionModel) {
 
   // Interrupted after episode 4 and resumed: the same episodes, refit included, and the same choice.
   const std::string resumed_dir = temp_dir("best_resumed");
-  RunResult resumed;
-  run_until_stopped(best_config, resumed_dir, 3, resumed);
-  {
-    Trainer t(best_config, resumed_dir, collecting(resumed));
-    t.resume();
-    EXPECT_TRUE(t.run());
-  }
+  const RunResult resumed = run_stopped_and_resumed(best_config, resumed_dir, 3);
   EXPECT_EQ(resumed.episodes, r.episodes);
   EXPECT_EQ(YAML::LoadFile(resumed_dir + "/checkpoint/trainer.yaml")["best_motion"]["episode"].as<int>(), expected);
   EXPECT_EQ(lines(best_config, resumed_dir), lines(best_config, dir));
@@ -795,6 +801,73 @@ TEST(Trainer, KeepBestMotionFreezesTheBestEvaluatedMotionModel) {
   const std::string refused = test_support::error_of([&] { load_coopt_config(kCi, {"trainer.keep_best_motion=true"}); });
   EXPECT_NE(refused.find("trainer.keep_best_motion"), std::string::npos) << refused;
   for (const std::string& d : {dir, plain_dir, cut_dir, resumed_dir}) fs::remove_all(d);
+}
+
+// trainer.motion_average_episodes: the refit freezes the mean of the motion
+// model's snapshots over the last training episodes (here after episodes 4, 5
+// and 6), the run ends with it, and a run interrupted between snapshots
+// resumes to the same mean.
+TEST(Trainer, MotionAverageFreezesTheMeanOfTheLastSnapshots) {
+  // ci: 2 warm-up + 4 training episodes, then 3 refit episodes.
+  const std::vector<std::string> plain{"trainer.config_refit_episodes=3", "trainer.checkpoint_interval=1"};
+  std::vector<std::string> averaged = with(plain, "trainer.motion_average_episodes=2");
+  averaged.push_back("trainer.motion_average_interval=1");
+  const CooptConfig plain_config = load_coopt_config(kCi, plain), averaged_config = load_coopt_config(kCi, averaged);
+  const std::string dir = temp_dir("average"), plain_dir = temp_dir("average_plain");
+  const RunResult r = run_ci(averaged, dir);
+  const RunResult plain_run = run_ci(plain, plain_dir);
+  EXPECT_EQ(YAML::LoadFile(dir + "/checkpoint/trainer.yaml")["motion_average_snapshots"].as<int>(), 3);
+  // Training is the plain run's; the refit drives the mean, not the last model.
+  ASSERT_EQ(r.episodes.size(), 9u);
+  ASSERT_EQ(plain_run.episodes.size(), 9u);
+  for (int e = 0; e < 6; ++e) EXPECT_EQ(r.episodes[e], plain_run.episodes[e]) << "episode " << e;
+  EXPECT_NE(std::vector<std::string>(r.episodes.begin() + 6, r.episodes.end()),
+            std::vector<std::string>(plain_run.episodes.begin() + 6, plain_run.episodes.end()));
+
+  // The motion models of the plain run after 4, 5 and 6 episodes (runs stopped there), and their mean.
+  const auto parameters = [&](const std::string& run) {
+    auto learner = make_motion_learner(plain_config, 0);
+    learner->load_acting_networks(run + "/checkpoint/motion_actor.pt");
+    std::vector<torch::Tensor> out;
+    for (const torch::Tensor& p : learner->acting_networks().parameters()) out.push_back(p.detach().clone());
+    return out;
+  };
+  std::vector<torch::Tensor> mean;
+  std::vector<std::string> cut_dirs;
+  for (int done : {4, 5, 6}) {
+    cut_dirs.push_back(temp_dir("average_cut" + std::to_string(done)));
+    RunResult cut;
+    run_until_stopped(plain_config, cut_dirs.back(), done - 1, cut);
+    const std::vector<torch::Tensor> p = parameters(cut_dirs.back());
+    if (mean.empty())
+      for (const torch::Tensor& t : p) mean.push_back(torch::zeros_like(t));
+    for (std::size_t i = 0; i < p.size(); ++i) mean[i] += p[i] / 3.0;
+  }
+  const std::vector<torch::Tensor> last = parameters(plain_dir), got = parameters(dir);
+  ASSERT_EQ(got.size(), mean.size());
+  bool differs_from_last = false;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    EXPECT_TRUE(torch::allclose(got[i], mean[i], 1e-5, 1e-6)) << "parameter " << i;
+    differs_from_last = differs_from_last || !torch::allclose(got[i], last[i], 1e-5, 1e-6);
+  }
+  EXPECT_TRUE(differs_from_last) << "the snapshots did not differ: nothing was averaged";
+
+  // Interrupted after episode 5 (two snapshots in) and resumed: the same episodes and the same mean.
+  const std::string resumed_dir = temp_dir("average_resumed");
+  const RunResult resumed = run_stopped_and_resumed(averaged_config, resumed_dir, 4);
+  EXPECT_EQ(resumed.episodes, r.episodes);
+  const std::vector<torch::Tensor> resumed_mean = parameters(resumed_dir);
+  for (std::size_t i = 0; i < got.size(); ++i) EXPECT_TRUE(torch::equal(resumed_mean[i], got[i])) << "parameter " << i;
+
+  // Refused, naming the key: with keep_best_motion, and over more episodes than training has.
+  for (const std::string bad : {"trainer.keep_best_motion=true", "trainer.motion_average_episodes=5"}) {
+    std::vector<std::string> sets = with(averaged, bad);
+    if (bad.find("keep_best") != std::string::npos) sets.push_back("trainer.eval_interval=1");
+    const std::string refused = test_support::error_of([&] { load_coopt_config(kCi, sets); });
+    EXPECT_NE(refused.find("trainer.motion_average_episodes"), std::string::npos) << refused;
+  }
+  for (const std::string& d : {dir, plain_dir, resumed_dir}) fs::remove_all(d);
+  for (const std::string& d : cut_dirs) fs::remove_all(d);
 }
 
 // scene_source: classifier runs the ResNet-18 on the last 10 depth frames at
