@@ -59,9 +59,10 @@ int block_end(const TrainerParams& t, int from) {
   auto next_multiple = [from](int k) { return (from / k + 1) * k; };
   int end = std::min(t.total_episodes(), next_multiple(t.checkpoint_interval));
   if (t.eval_interval > 0) end = std::min(end, next_multiple(t.eval_interval));
-  if (t.motion_average_episodes > 0 && from < t.refit_start())
-    end = std::min(end, next_multiple(t.motion_average_interval));
-  if (from < t.refit_start()) end = std::min(end, t.refit_start());
+  if (from < t.refit_start()) {
+    end = std::min(end, t.refit_start());
+    if (t.motion_average_episodes > 0) end = std::min(end, next_multiple(t.motion_average_interval));
+  }
   return end;
 }
 

@@ -860,9 +860,10 @@ TEST(Trainer, MotionAverageFreezesTheMeanOfTheLastSnapshots) {
   for (std::size_t i = 0; i < got.size(); ++i) EXPECT_TRUE(torch::equal(resumed_mean[i], got[i])) << "parameter " << i;
 
   // Refused, naming the key: with keep_best_motion, and over more episodes than training has.
-  for (const std::string bad : {"trainer.keep_best_motion=true", "trainer.motion_average_episodes=5"}) {
-    std::vector<std::string> sets = with(averaged, bad);
-    if (bad.find("keep_best") != std::string::npos) sets.push_back("trainer.eval_interval=1");
+  for (const std::vector<std::string>& bad : std::vector<std::vector<std::string>>{
+           {"trainer.keep_best_motion=true", "trainer.eval_interval=1"}, {"trainer.motion_average_episodes=5"}}) {
+    std::vector<std::string> sets = averaged;
+    sets.insert(sets.end(), bad.begin(), bad.end());
     const std::string refused = test_support::error_of([&] { load_coopt_config(kCi, sets); });
     EXPECT_NE(refused.find("trainer.motion_average_episodes"), std::string::npos) << refused;
   }
